@@ -1,0 +1,229 @@
+//! Acceleration structures, all behind one interface.
+//!
+//! A structure is built from the primitives' bounding boxes alone and never sees their geometry:
+//! a query takes a closure that tests primitive `i` exactly. So spheres, triangles, instances and
+//! user shapes all work with every structure, and the work counters of [`counters`] measure every
+//! structure the same way.
+
+pub mod brute;
+pub mod counters;
+
+use std::fmt;
+use std::str::FromStr;
+
+pub use brute::BruteForce;
+pub use counters::{Counters, NoCount, WorkCounts};
+
+use crate::shapes::PrimHit;
+use crate::{Aabb, Ray};
+
+/// The closest hit of a query: the primitive's index and where it was hit.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Hit {
+    /// Ray parameter of the hit.
+    pub t: f32,
+    /// Index of the primitive in the list the structure was built from.
+    pub prim: u32,
+    /// First surface coordinate (see [`PrimHit`]).
+    pub u: f32,
+    /// Second surface coordinate.
+    pub v: f32,
+}
+
+/// The interface every acceleration structure implements.
+///
+/// Both queries honour the ray's `t_min..=t_max` and answer "no hit" for invalid rays
+/// ([`Ray::is_valid`]) without visiting anything. The closure receives the ray with `t_max`
+/// shrunk to the closest hit found so far, so it can reject farther hits early.
+pub trait Accel: Send + Sync {
+    /// The box around everything the structure holds.
+    fn bounds(&self) -> Aabb;
+
+    /// The closest primitive hit. Of two primitives hit at exactly the same `t`, the one with the
+    /// lower index wins, so every structure gives the same answer as brute force.
+    fn closest_hit<C: Counters>(
+        &self,
+        ray: &Ray,
+        counters: &mut C,
+        intersect: impl FnMut(u32, &Ray) -> Option<PrimHit>,
+    ) -> Option<Hit>;
+
+    /// Whether any primitive is hit; stops at the first one (shadow rays).
+    fn any_hit<C: Counters>(&self, ray: &Ray, counters: &mut C, occludes: impl FnMut(u32, &Ray) -> bool) -> bool;
+
+    /// Size and shape of the structure.
+    fn stats(&self) -> StructureStats;
+}
+
+/// Size and shape of a built structure, for comparisons.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct StructureStats {
+    /// Interior nodes (or cells for a grid).
+    pub nodes: usize,
+    /// Leaves (or non-empty cells).
+    pub leaves: usize,
+    /// Longest path from the root to a leaf (0 when there is no tree).
+    pub depth: usize,
+    /// Primitive references stored in leaves (a primitive may be referenced more than once by
+    /// spatial subdivisions).
+    pub prim_refs: usize,
+    /// Bytes used by the structure.
+    pub memory_bytes: usize,
+    /// Expected cost of a random ray under the surface area heuristic, where it applies.
+    pub sah_cost: Option<f32>,
+}
+
+/// The closest hit found so far during a query, and the ray shrunk to it. Every structure offers
+/// its candidates through this, so they all break ties the same way.
+#[derive(Clone, Copy, Debug)]
+pub struct HitRecord {
+    /// The query ray with `t_max` shrunk to the closest hit so far.
+    pub ray: Ray,
+    /// The closest hit so far.
+    pub hit: Option<Hit>,
+}
+
+impl HitRecord {
+    /// No hit yet.
+    #[inline(always)]
+    pub fn new(ray: Ray) -> Self {
+        HitRecord { ray, hit: None }
+    }
+
+    /// Keeps `hit` on `prim` if it is closer than the current one, or as close with a lower
+    /// index. Returns true if it was kept.
+    #[inline(always)]
+    pub fn offer(&mut self, prim: u32, hit: PrimHit) -> bool {
+        let better = match self.hit {
+            None => true,
+            Some(best) => hit.t < best.t || (hit.t == best.t && prim < best.prim),
+        };
+        if better {
+            self.hit = Some(Hit { t: hit.t, prim, u: hit.u, v: hit.v });
+            self.ray.t_max = hit.t;
+        }
+        better
+    }
+}
+
+/// The structures, by name: what `--accel` accepts.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum AccelKind {
+    /// Brute force: no structure.
+    None,
+}
+
+impl AccelKind {
+    /// Every structure, in the order tables list them.
+    pub const ALL: &'static [AccelKind] = &[AccelKind::None];
+
+    /// The name used on the command line and in tables.
+    pub fn name(self) -> &'static str {
+        match self {
+            AccelKind::None => "none",
+        }
+    }
+
+    /// One line saying what the structure is.
+    pub fn description(self) -> &'static str {
+        match self {
+            AccelKind::None => "brute force: every ray tests every primitive",
+        }
+    }
+}
+
+impl fmt::Display for AccelKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// An unknown structure name.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("unknown accelerator `{given}`; expected one of: {}", AccelKind::ALL.iter().map(|k| k.name()).collect::<Vec<_>>().join(", "))]
+pub struct UnknownAccel {
+    /// The name that was given.
+    pub given: String,
+}
+
+impl FromStr for AccelKind {
+    type Err = UnknownAccel;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        AccelKind::ALL.iter().copied().find(|k| k.name() == s).ok_or_else(|| UnknownAccel { given: s.to_owned() })
+    }
+}
+
+/// Any structure, chosen at run time by [`AccelKind`]. Dispatch is one `match` per query, and
+/// each arm is the structure's own fully inlined traversal.
+#[derive(Clone, Debug)]
+pub enum AnyAccel {
+    /// See [`BruteForce`].
+    BruteForce(BruteForce),
+}
+
+impl AnyAccel {
+    /// Builds the structure `kind` over the primitives' boxes.
+    pub fn build(kind: AccelKind, boxes: &[Aabb]) -> Self {
+        match kind {
+            AccelKind::None => AnyAccel::BruteForce(BruteForce::build(boxes)),
+        }
+    }
+}
+
+macro_rules! dispatch_accel {
+    ($self:ident, $a:ident => $e:expr) => {
+        match $self {
+            AnyAccel::BruteForce($a) => $e,
+        }
+    };
+}
+
+impl Accel for AnyAccel {
+    fn bounds(&self) -> Aabb {
+        dispatch_accel!(self, a => a.bounds())
+    }
+
+    #[inline]
+    fn closest_hit<C: Counters>(
+        &self,
+        ray: &Ray,
+        counters: &mut C,
+        intersect: impl FnMut(u32, &Ray) -> Option<PrimHit>,
+    ) -> Option<Hit> {
+        dispatch_accel!(self, a => a.closest_hit(ray, counters, intersect))
+    }
+
+    #[inline]
+    fn any_hit<C: Counters>(&self, ray: &Ray, counters: &mut C, occludes: impl FnMut(u32, &Ray) -> bool) -> bool {
+        dispatch_accel!(self, a => a.any_hit(ray, counters, occludes))
+    }
+
+    fn stats(&self) -> StructureStats {
+        dispatch_accel!(self, a => a.stats())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_round_trip() {
+        for &k in AccelKind::ALL {
+            assert_eq!(k.name().parse::<AccelKind>().unwrap(), k);
+        }
+        let err = "octree".parse::<AccelKind>().unwrap_err();
+        assert!(err.to_string().contains("none"), "{err}");
+    }
+
+    #[test]
+    fn ties_go_to_the_lower_index() {
+        let mut r = HitRecord::new(Ray::new(glam::Vec3::ZERO, glam::Vec3::X));
+        assert!(r.offer(5, PrimHit::at(2.0)));
+        assert!(r.offer(3, PrimHit::at(2.0)));
+        assert!(!r.offer(4, PrimHit::at(2.0)));
+        assert!(!r.offer(0, PrimHit::at(2.5)));
+        assert_eq!(r.hit.unwrap().prim, 3);
+        assert_eq!(r.ray.t_max, 2.0);
+    }
+}

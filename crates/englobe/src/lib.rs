@@ -1,0 +1,31 @@
+//! # englobe
+//!
+//! Ray queries accelerated by bounding volumes. The name comes from the French *volumes
+//! englobants*: bounding volumes, the answer a 2009 student report gave to the question "which
+//! objects can a ray possibly hit?", and the thread this library follows.
+//!
+//! * Geometry: [`Ray`], [`Aabb`] and the [`shapes`] (sphere, plane, box, triangle, mesh).
+//! * Acceleration structures behind one interface, [`accel::Accel`], with work counters.
+//! * [`World`]: objects plus a structure, answering closest-hit and any-hit queries.
+//!
+//! ```
+//! use englobe::{AccelKind, NoCount, Ray, Sphere, Vec3, World};
+//!
+//! let world = World::build(vec![Sphere::new(Vec3::new(0.0, 0.0, 5.0), 1.0).into()], AccelKind::None)?;
+//! let hit = world.closest_hit(&Ray::new(Vec3::ZERO, Vec3::Z), &mut NoCount).expect("a hit");
+//! assert_eq!((hit.object, hit.t), (0, 4.0));
+//! # Ok::<(), englobe::WorldError>(())
+//! ```
+
+pub mod aabb;
+pub mod accel;
+pub mod ray;
+pub mod shapes;
+pub mod world;
+
+pub use aabb::Aabb;
+pub use accel::{Accel, AccelKind, AnyAccel, Counters, Hit, NoCount, WorkCounts};
+pub use glam::{Vec2, Vec3};
+pub use ray::Ray;
+pub use shapes::{AaBox, Bounded, Intersect, Plane, PrimHit, Shape, Sphere, Triangle, TriangleMesh};
+pub use world::{Object, World, WorldError, WorldHit};

@@ -1,0 +1,113 @@
+//! Rays: an origin, a direction and the interval `t_min..=t_max` of parameters that count as hits.
+//!
+//! The inverse direction is computed once per ray because every box test needs it. A zero
+//! direction component (of either sign) gets an inverse of `+inf`, never `-inf`: the slab test in
+//! [`crate::Aabb`] relies on that to treat a ray lying in a box face consistently (see there).
+
+use glam::Vec3;
+
+/// A ray `origin + t * dir` for `t` in the closed interval `t_min..=t_max`.
+///
+/// The direction need not be normalised; `t` is measured in units of its length. The interval is
+/// closed so that two primitives hit at exactly the same `t` can be told apart by index, whatever
+/// order a structure visits them in.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Ray {
+    origin: Vec3,
+    dir: Vec3,
+    inv_dir: Vec3,
+    /// Smallest parameter that counts as a hit.
+    pub t_min: f32,
+    /// Largest parameter that counts as a hit; structures shrink it as they find closer hits.
+    pub t_max: f32,
+}
+
+impl Ray {
+    /// A ray over `0..=inf`.
+    #[inline]
+    pub fn new(origin: Vec3, dir: Vec3) -> Self {
+        Self::segment(origin, dir, 0.0, f32::INFINITY)
+    }
+
+    /// A ray over `t_min..=t_max`.
+    #[inline]
+    pub fn segment(origin: Vec3, dir: Vec3, t_min: f32, t_max: f32) -> Self {
+        Ray {
+            origin,
+            dir,
+            inv_dir: Vec3::new(safe_inverse(dir.x), safe_inverse(dir.y), safe_inverse(dir.z)),
+            t_min,
+            t_max,
+        }
+    }
+
+    /// The origin.
+    #[inline(always)]
+    pub fn origin(&self) -> Vec3 {
+        self.origin
+    }
+
+    /// The direction, as given (not normalised).
+    #[inline(always)]
+    pub fn dir(&self) -> Vec3 {
+        self.dir
+    }
+
+    /// `1 / dir` per component, with `+inf` for zero components of either sign.
+    #[inline(always)]
+    pub fn inv_dir(&self) -> Vec3 {
+        self.inv_dir
+    }
+
+    /// The point at parameter `t`.
+    #[inline(always)]
+    pub fn at(&self, t: f32) -> Vec3 {
+        self.origin + self.dir * t
+    }
+
+    /// The same ray over a different interval.
+    #[inline(always)]
+    pub fn with_range(&self, t_min: f32, t_max: f32) -> Self {
+        Ray { t_min, t_max, ..*self }
+    }
+
+    /// A ray can hit something only if its origin and direction are finite, its direction is not
+    /// zero and its interval is not empty (NaN bounds make it empty). Structures answer "no hit"
+    /// for any other ray without traversing anything.
+    #[inline]
+    pub fn is_valid(&self) -> bool {
+        self.origin.is_finite() && self.dir.is_finite() && self.dir != Vec3::ZERO && self.t_min <= self.t_max
+    }
+}
+
+/// `1 / x`, except that both zeros map to `+inf` so that the slab test's NaN handling only ever
+/// has to deal with one sign.
+#[inline(always)]
+fn safe_inverse(x: f32) -> f32 {
+    if x == 0.0 { f32::INFINITY } else { 1.0 / x }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn inverse_of_zero_is_positive_infinity_for_both_signs() {
+        let r = Ray::new(Vec3::ZERO, Vec3::new(0.0, -0.0, 2.0));
+        assert_eq!(r.inv_dir().x, f32::INFINITY);
+        assert_eq!(r.inv_dir().y, f32::INFINITY);
+        assert_eq!(r.inv_dir().z, 0.5);
+    }
+
+    #[test]
+    fn validity() {
+        assert!(Ray::new(Vec3::ZERO, Vec3::X).is_valid());
+        assert!(!Ray::new(Vec3::ZERO, Vec3::ZERO).is_valid());
+        assert!(!Ray::new(Vec3::new(f32::NAN, 0.0, 0.0), Vec3::X).is_valid());
+        assert!(!Ray::new(Vec3::ZERO, Vec3::new(f32::INFINITY, 0.0, 0.0)).is_valid());
+        assert!(!Ray::segment(Vec3::ZERO, Vec3::X, 0.0, f32::NAN).is_valid());
+        assert!(!Ray::segment(Vec3::ZERO, Vec3::X, f32::NAN, 1.0).is_valid());
+        assert!(!Ray::segment(Vec3::ZERO, Vec3::X, 2.0, 1.0).is_valid());
+        assert!(Ray::segment(Vec3::ZERO, Vec3::X, 1.0, 1.0).is_valid());
+    }
+}

@@ -1,0 +1,204 @@
+//! Indexed triangle meshes: one vertex array shared by many triangles, each triangle a primitive
+//! of its own for the acceleration structures.
+
+use glam::{Vec2, Vec3};
+
+use super::triangle::{WatertightRay, intersect_triangle};
+use super::{PrimHit, Triangle};
+use crate::{Aabb, Ray};
+
+/// Why a mesh was refused.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum MeshError {
+    /// A triangle refers to a vertex that does not exist.
+    #[error("triangle {triangle} refers to vertex {index}, but the mesh has {vertices} vertices")]
+    IndexOutOfRange {
+        /// Triangle number.
+        triangle: usize,
+        /// The bad index.
+        index: u32,
+        /// Number of vertices.
+        vertices: usize,
+    },
+    /// A vertex position is NaN or infinite.
+    #[error("vertex {vertex} has a non-finite coordinate: {position:?}")]
+    NonFiniteVertex {
+        /// Vertex number.
+        vertex: usize,
+        /// Its position.
+        position: Vec3,
+    },
+    /// A per-vertex attribute array does not have one entry per vertex.
+    #[error("{attribute} has {got} entries for {vertices} vertices")]
+    AttributeCount {
+        /// Which attribute.
+        attribute: &'static str,
+        /// Entries given.
+        got: usize,
+        /// Number of vertices.
+        vertices: usize,
+    },
+    /// More than `u32::MAX` vertices or triangles.
+    #[error("the mesh is too large: {0} elements do not fit 32-bit indices")]
+    TooLarge(usize),
+}
+
+/// An indexed triangle mesh with optional per-vertex normals (for smooth shading) and texture
+/// coordinates. Construction checks every index and coordinate, so queries never can fail.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TriangleMesh {
+    positions: Vec<Vec3>,
+    triangles: Vec<[u32; 3]>,
+    normals: Option<Vec<Vec3>>,
+    uvs: Option<Vec<Vec2>>,
+}
+
+impl TriangleMesh {
+    /// A mesh from vertex positions and triangles (vertex indices, counter-clockwise).
+    pub fn new(positions: Vec<Vec3>, triangles: Vec<[u32; 3]>) -> Result<Self, MeshError> {
+        for n in [positions.len(), triangles.len()] {
+            if n > u32::MAX as usize {
+                return Err(MeshError::TooLarge(n));
+            }
+        }
+        if let Some((vertex, &position)) = positions.iter().enumerate().find(|(_, p)| !p.is_finite()) {
+            return Err(MeshError::NonFiniteVertex { vertex, position });
+        }
+        for (triangle, t) in triangles.iter().enumerate() {
+            if let Some(&index) = t.iter().find(|&&i| i as usize >= positions.len()) {
+                return Err(MeshError::IndexOutOfRange { triangle, index, vertices: positions.len() });
+            }
+        }
+        Ok(TriangleMesh { positions, triangles, normals: None, uvs: None })
+    }
+
+    /// Adds per-vertex normals (one per vertex; normalised when used).
+    pub fn with_normals(mut self, normals: Vec<Vec3>) -> Result<Self, MeshError> {
+        if normals.len() != self.positions.len() {
+            return Err(MeshError::AttributeCount {
+                attribute: "normals",
+                got: normals.len(),
+                vertices: self.positions.len(),
+            });
+        }
+        self.normals = Some(normals);
+        Ok(self)
+    }
+
+    /// Adds per-vertex texture coordinates.
+    pub fn with_uvs(mut self, uvs: Vec<Vec2>) -> Result<Self, MeshError> {
+        if uvs.len() != self.positions.len() {
+            return Err(MeshError::AttributeCount { attribute: "uvs", got: uvs.len(), vertices: self.positions.len() });
+        }
+        self.uvs = Some(uvs);
+        Ok(self)
+    }
+
+    /// Vertex positions.
+    pub fn positions(&self) -> &[Vec3] {
+        &self.positions
+    }
+
+    /// Triangles as vertex indices.
+    pub fn triangles(&self) -> &[[u32; 3]] {
+        &self.triangles
+    }
+
+    /// Per-vertex normals, if any.
+    pub fn normals(&self) -> Option<&[Vec3]> {
+        self.normals.as_deref()
+    }
+
+    /// Per-vertex texture coordinates, if any.
+    pub fn uvs(&self) -> Option<&[Vec2]> {
+        self.uvs.as_deref()
+    }
+
+    /// Number of triangles.
+    pub fn len(&self) -> usize {
+        self.triangles.len()
+    }
+
+    /// True if the mesh has no triangle.
+    pub fn is_empty(&self) -> bool {
+        self.triangles.is_empty()
+    }
+
+    /// Triangle `i` as three points.
+    #[inline(always)]
+    pub fn triangle(&self, i: u32) -> Triangle {
+        let [a, b, c] = self.triangles[i as usize];
+        Triangle::new(self.positions[a as usize], self.positions[b as usize], self.positions[c as usize])
+    }
+
+    /// Bounding box of triangle `i`.
+    pub fn triangle_bounds(&self, i: u32) -> Aabb {
+        Aabb::from_points(self.triangle(i).vertices)
+    }
+
+    /// Bounding box of the whole mesh.
+    pub fn bounds(&self) -> Aabb {
+        Aabb::from_points(self.positions.iter().copied())
+    }
+
+    /// The watertight test of the ray against triangle `i`.
+    #[inline(always)]
+    pub fn intersect(&self, i: u32, ray: &Ray) -> Option<PrimHit> {
+        let t = self.triangle(i);
+        intersect_triangle(ray, &WatertightRay::new(ray), t.vertices[0], t.vertices[1], t.vertices[2])
+    }
+
+    /// The unit geometric normal of triangle `i` (zero for a degenerate one).
+    pub fn geometric_normal(&self, i: u32) -> Vec3 {
+        let [a, b, c] = self.triangle(i).vertices;
+        (b - a).cross(c - a).normalize_or_zero()
+    }
+
+    /// The normal for shading at barycentric `(u, v)` on triangle `i`: interpolated from the
+    /// vertex normals when the mesh has them, the geometric normal otherwise.
+    pub fn shading_normal(&self, i: u32, u: f32, v: f32) -> Vec3 {
+        let geometric = self.geometric_normal(i);
+        let Some(normals) = &self.normals else { return geometric };
+        let [a, b, c] = self.triangles[i as usize];
+        let n = normals[a as usize] * (1.0 - u - v) + normals[b as usize] * u + normals[c as usize] * v;
+        n.try_normalize().unwrap_or(geometric)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn quad() -> TriangleMesh {
+        TriangleMesh::new(vec![Vec3::ZERO, Vec3::X, Vec3::new(1.0, 1.0, 0.0), Vec3::Y], vec![[0, 1, 2], [0, 2, 3]])
+            .unwrap()
+    }
+
+    #[test]
+    fn bad_meshes_are_refused() {
+        let e = TriangleMesh::new(vec![Vec3::ZERO; 3], vec![[0, 1, 3]]).unwrap_err();
+        assert!(matches!(e, MeshError::IndexOutOfRange { index: 3, .. }), "{e}");
+        let e = TriangleMesh::new(vec![Vec3::ZERO, Vec3::new(f32::NAN, 0.0, 0.0)], vec![]).unwrap_err();
+        assert!(matches!(e, MeshError::NonFiniteVertex { vertex: 1, .. }), "{e}");
+        assert!(quad().with_normals(vec![Vec3::Z]).is_err());
+    }
+
+    #[test]
+    fn triangles_of_a_mesh_are_hit() {
+        let m = quad();
+        let ray = Ray::new(Vec3::new(0.2, 0.7, 1.0), -Vec3::Z);
+        assert!(m.intersect(0, &ray).is_none());
+        assert_eq!(m.intersect(1, &ray).unwrap().t, 1.0);
+        assert_eq!(m.geometric_normal(1), Vec3::Z);
+        assert_eq!(m.bounds(), Aabb::new(Vec3::ZERO, Vec3::new(1.0, 1.0, 0.0)));
+    }
+
+    #[test]
+    fn shading_normals_interpolate() {
+        let m = quad().with_normals(vec![Vec3::Z, Vec3::Z, Vec3::X, Vec3::Z]).unwrap();
+        let n = m.shading_normal(0, 0.0, 1.0);
+        assert_eq!(n, Vec3::X);
+        let n = m.shading_normal(0, 0.0, 0.5);
+        assert!((n - Vec3::new(1.0, 0.0, 1.0).normalize()).length() < 1e-6);
+    }
+}

@@ -1,0 +1,113 @@
+//! The shapes a ray can hit, each with its exact intersection, its normal and its own bounding box
+//! (the seed report's "one bounding-box function per kind of object").
+
+mod aabox;
+mod mesh;
+mod plane;
+mod sphere;
+mod triangle;
+
+pub use aabox::AaBox;
+pub use mesh::{MeshError, TriangleMesh};
+pub use plane::Plane;
+pub use sphere::Sphere;
+pub use triangle::{Triangle, WatertightRay, intersect_triangle};
+
+use glam::Vec3;
+
+use crate::{Aabb, Ray};
+
+/// Where a ray meets one primitive: its parameter `t` and two surface coordinates (barycentric
+/// weights of the second and third vertex for triangles, zero for other shapes).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PrimHit {
+    /// Ray parameter of the hit.
+    pub t: f32,
+    /// First surface coordinate.
+    pub u: f32,
+    /// Second surface coordinate.
+    pub v: f32,
+}
+
+impl PrimHit {
+    /// A hit with no surface coordinates.
+    #[inline(always)]
+    pub fn at(t: f32) -> Self {
+        PrimHit { t, u: 0.0, v: 0.0 }
+    }
+}
+
+/// Anything with a bounding box. Unbounded shapes (planes) return a box with infinite corners.
+pub trait Bounded {
+    /// The tightest axis-aligned box around the shape.
+    fn bounds(&self) -> Aabb;
+}
+
+/// A shape a ray can be tested against exactly.
+pub trait Intersect: Bounded {
+    /// The nearest hit with `t` in the ray's interval `t_min..=t_max`, if any.
+    fn intersect(&self, ray: &Ray) -> Option<PrimHit>;
+
+    /// The unit geometric normal at the surface point `p` of `hit`. It points outward for closed
+    /// shapes and along the winding's right-hand normal for triangles, whichever side the ray came from.
+    fn normal(&self, p: Vec3, hit: &PrimHit) -> Vec3;
+}
+
+/// One shape of any kind, the unit a [`crate::World`] is made of.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Shape {
+    /// A sphere.
+    Sphere(Sphere),
+    /// An infinite plane (unbounded: kept beside the acceleration structure).
+    Plane(Plane),
+    /// An axis-aligned box.
+    AaBox(AaBox),
+    /// A triangle.
+    Triangle(Triangle),
+}
+
+impl Shape {
+    /// False for shapes with no finite bounding box, which acceleration structures cannot hold.
+    pub fn is_bounded(&self) -> bool {
+        !matches!(self, Shape::Plane(_))
+    }
+}
+
+macro_rules! dispatch {
+    ($self:ident, $s:ident => $e:expr) => {
+        match $self {
+            Shape::Sphere($s) => $e,
+            Shape::Plane($s) => $e,
+            Shape::AaBox($s) => $e,
+            Shape::Triangle($s) => $e,
+        }
+    };
+}
+
+impl Bounded for Shape {
+    fn bounds(&self) -> Aabb {
+        dispatch!(self, s => s.bounds())
+    }
+}
+
+impl Intersect for Shape {
+    #[inline]
+    fn intersect(&self, ray: &Ray) -> Option<PrimHit> {
+        dispatch!(self, s => s.intersect(ray))
+    }
+
+    fn normal(&self, p: Vec3, hit: &PrimHit) -> Vec3 {
+        dispatch!(self, s => s.normal(p, hit))
+    }
+}
+
+macro_rules! impl_from {
+    ($($t:ident),*) => {$(
+        impl From<$t> for Shape {
+            fn from(s: $t) -> Self {
+                Shape::$t(s)
+            }
+        }
+    )*};
+}
+impl_from!(Sphere, Plane, AaBox, Triangle);

@@ -1,0 +1,214 @@
+//! Triangles, with the watertight ray/triangle test of Woop, Benthin and Wald (2013),
+//! "Watertight Ray/Triangle Intersection" (JCGT 2(1)).
+//!
+//! The vertices are moved into a frame where the ray runs along +z from the origin; the test then
+//! reduces to 2D edge functions evaluated with the same operations, in the same order, for the two
+//! triangles that share an edge, so a ray through a shared edge or vertex can never slip between
+//! them. Edge functions that come out exactly zero are recomputed in `f64`, as the paper
+//! prescribes, so that the sign decision on an edge is exact. A zero-area triangle has a zero
+//! determinant and is never hit.
+
+use glam::{DVec2, Vec3};
+
+use super::{Bounded, Intersect, PrimHit};
+use crate::{Aabb, Ray};
+
+/// A triangle given by its three vertices.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Triangle {
+    /// The vertices, counter-clockwise around the normal.
+    pub vertices: [Vec3; 3],
+}
+
+impl Triangle {
+    /// A triangle.
+    pub fn new(a: Vec3, b: Vec3, c: Vec3) -> Self {
+        Triangle { vertices: [a, b, c] }
+    }
+
+    /// Twice the area: zero for degenerate triangles.
+    pub fn double_area(&self) -> f32 {
+        let [a, b, c] = self.vertices;
+        (b - a).cross(c - a).length()
+    }
+}
+
+/// The per-ray constants of the watertight test: the axis the ray runs along (`kz`), the two
+/// others (`kx`, `ky`, swapped to keep the winding), and the shear that maps the ray onto +z.
+#[derive(Clone, Copy, Debug)]
+pub struct WatertightRay {
+    kx: usize,
+    ky: usize,
+    kz: usize,
+    shear: Vec3,
+}
+
+impl WatertightRay {
+    /// The constants for `ray`.
+    #[inline(always)]
+    pub fn new(ray: &Ray) -> Self {
+        let d = ray.dir();
+        let a = d.abs();
+        let kz = if a.x >= a.y && a.x >= a.z {
+            0
+        } else if a.y >= a.z {
+            1
+        } else {
+            2
+        };
+        let mut kx = (kz + 1) % 3;
+        let mut ky = (kx + 1) % 3;
+        if d[kz] < 0.0 {
+            std::mem::swap(&mut kx, &mut ky);
+        }
+        let shear = Vec3::new(d[kx] / d[kz], d[ky] / d[kz], 1.0 / d[kz]);
+        WatertightRay { kx, ky, kz, shear }
+    }
+}
+
+/// The watertight test of `ray` against the triangle `v0 v1 v2`, with the ray's constants `w`.
+/// Returns `t` within the ray's interval and the barycentric weights `(u, v)` of `v1` and `v2`.
+/// Both sides of the triangle are hit.
+#[inline(always)]
+pub fn intersect_triangle(ray: &Ray, w: &WatertightRay, v0: Vec3, v1: Vec3, v2: Vec3) -> Option<PrimHit> {
+    let o = ray.origin();
+    let (a, b, c) = (v0 - o, v1 - o, v2 - o);
+    let (sx, sy, sz) = (w.shear.x, w.shear.y, w.shear.z);
+    let ax = a[w.kx] - sx * a[w.kz];
+    let ay = a[w.ky] - sy * a[w.kz];
+    let bx = b[w.kx] - sx * b[w.kz];
+    let by = b[w.ky] - sy * b[w.kz];
+    let cx = c[w.kx] - sx * c[w.kz];
+    let cy = c[w.ky] - sy * c[w.kz];
+
+    let mut e0 = cx * by - cy * bx;
+    let mut e1 = ax * cy - ay * cx;
+    let mut e2 = bx * ay - by * ax;
+    if e0 == 0.0 || e1 == 0.0 || e2 == 0.0 {
+        let edge = |p: DVec2, q: DVec2| (p.x * q.y - p.y * q.x) as f32;
+        let (a2, b2, c2) =
+            (DVec2::new(ax as f64, ay as f64), DVec2::new(bx as f64, by as f64), DVec2::new(cx as f64, cy as f64));
+        e0 = edge(c2, b2);
+        e1 = edge(a2, c2);
+        e2 = edge(b2, a2);
+    }
+    if (e0 < 0.0 || e1 < 0.0 || e2 < 0.0) && (e0 > 0.0 || e1 > 0.0 || e2 > 0.0) {
+        return None;
+    }
+    let det = e0 + e1 + e2;
+    if det == 0.0 || !det.is_finite() {
+        return None;
+    }
+    let az = sz * a[w.kz];
+    let bz = sz * b[w.kz];
+    let cz = sz * c[w.kz];
+    let t_scaled = e0 * az + e1 * bz + e2 * cz;
+    let inv_det = 1.0 / det;
+    let t = t_scaled * inv_det;
+    if !(t >= ray.t_min && t <= ray.t_max) {
+        return None;
+    }
+    Some(PrimHit { t, u: e1 * inv_det, v: e2 * inv_det })
+}
+
+impl Bounded for Triangle {
+    fn bounds(&self) -> Aabb {
+        Aabb::from_points(self.vertices)
+    }
+}
+
+impl Intersect for Triangle {
+    #[inline]
+    fn intersect(&self, ray: &Ray) -> Option<PrimHit> {
+        let [a, b, c] = self.vertices;
+        intersect_triangle(ray, &WatertightRay::new(ray), a, b, c)
+    }
+
+    fn normal(&self, _p: Vec3, _hit: &PrimHit) -> Vec3 {
+        let [a, b, c] = self.vertices;
+        (b - a).cross(c - a).normalize_or_zero()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn tri() -> Triangle {
+        Triangle::new(Vec3::ZERO, Vec3::X, Vec3::Y)
+    }
+
+    #[test]
+    fn hit_inside_gives_barycentrics() {
+        let hit = tri().intersect(&Ray::new(Vec3::new(0.25, 0.5, 2.0), -Vec3::Z)).unwrap();
+        assert_eq!(hit.t, 2.0);
+        assert!((hit.u - 0.25).abs() < 1e-6 && (hit.v - 0.5).abs() < 1e-6);
+        assert_eq!(tri().normal(Vec3::ZERO, &hit), Vec3::Z);
+    }
+
+    #[test]
+    fn both_sides_are_hit() {
+        assert!(tri().intersect(&Ray::new(Vec3::new(0.2, 0.2, -1.0), Vec3::Z)).is_some());
+    }
+
+    #[test]
+    fn ray_on_an_edge_and_a_vertex_hits() {
+        // On the edge x = 0, and exactly on vertex (1, 0, 0).
+        assert!(tri().intersect(&Ray::new(Vec3::new(0.0, 0.5, 1.0), -Vec3::Z)).is_some());
+        assert!(tri().intersect(&Ray::new(Vec3::new(1.0, 0.0, 1.0), -Vec3::Z)).is_some());
+        // On the hypotenuse x + y = 1.
+        assert!(tri().intersect(&Ray::new(Vec3::new(0.5, 0.5, 1.0), -Vec3::Z)).is_some());
+        assert!(tri().intersect(&Ray::new(Vec3::new(0.5, 0.5001, 1.0), -Vec3::Z)).is_none());
+    }
+
+    #[test]
+    fn shared_edge_is_hit_by_exactly_one_or_both_never_neither() {
+        // Two triangles sharing the diagonal of the unit square; rays along the diagonal.
+        let t1 = Triangle::new(Vec3::ZERO, Vec3::X, Vec3::new(1.0, 1.0, 0.0));
+        let t2 = Triangle::new(Vec3::ZERO, Vec3::new(1.0, 1.0, 0.0), Vec3::Y);
+        for i in 0..=1000 {
+            let s = i as f32 / 1000.0;
+            let o = Vec3::new(s, s, 3.0);
+            let d = Vec3::new(0.1 * s, -0.07, -1.0);
+            let ray = Ray::new(o - d * 0.0, d);
+            let p = ray.origin() + ray.dir() * 3.0;
+            let inside = (0.0..=1.0).contains(&p.x) && (0.0..=1.0).contains(&p.y);
+            if inside {
+                assert!(t1.intersect(&ray).is_some() || t2.intersect(&ray).is_some(), "slipped at {s}");
+            }
+        }
+    }
+
+    #[test]
+    fn degenerate_triangles_are_never_hit() {
+        let flat = Triangle::new(Vec3::ZERO, Vec3::X, Vec3::X * 2.0);
+        let point = Triangle::new(Vec3::ONE, Vec3::ONE, Vec3::ONE);
+        for ray in [
+            Ray::new(Vec3::new(0.5, 0.0, 1.0), -Vec3::Z),
+            Ray::new(Vec3::new(-1.0, 0.0, 0.0), Vec3::X),
+            Ray::new(Vec3::new(1.0, 1.0, 3.0), -Vec3::Z),
+        ] {
+            assert!(flat.intersect(&ray).is_none());
+            assert!(point.intersect(&ray).is_none());
+        }
+        assert_eq!(flat.double_area(), 0.0);
+    }
+
+    #[test]
+    fn ray_in_the_triangle_plane_misses_without_nan() {
+        assert!(tri().intersect(&Ray::new(Vec3::new(-1.0, 0.25, 0.0), Vec3::X)).is_none());
+    }
+
+    #[test]
+    fn interval_is_respected() {
+        let ray = Ray::segment(Vec3::new(0.2, 0.2, 2.0), -Vec3::Z, 0.0, 1.5);
+        assert!(tri().intersect(&ray).is_none());
+    }
+
+    #[test]
+    fn zero_direction_components_give_no_nan() {
+        let ray = Ray::new(Vec3::new(0.3, 0.3, 5.0), Vec3::new(-0.0, 0.0, -1.0));
+        let hit = tri().intersect(&ray).unwrap();
+        assert!(hit.t == 5.0 && hit.u.is_finite() && hit.v.is_finite());
+    }
+}
