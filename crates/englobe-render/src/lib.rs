@@ -1,14 +1,39 @@
-pub fn add(left: u64, right: u64) -> u64 {
-    left + right
-}
+//! # englobe-render
+//!
+//! englobe's renderer: a pinhole camera, point and directional lights, Phong-style materials with
+//! mirrors and glass, the Whitted integrator of the seed report, tiled parallel rendering that
+//! gives the same bytes on any number of threads, and atomic PNG/EXR output.
+//!
+//! ```
+//! # fn main() -> Result<(), Box<dyn std::error::Error>> {
+//! let scene = englobe_scene::parse_scene(englobe_render::DEFAULT_SCENE, "default.toml".as_ref())?;
+//! let world = englobe_render::build_world(&scene, englobe::AccelKind::None)?;
+//! let out = englobe_render::Renderer::new(&scene, &world).size(16, 12).render()?;
+//! assert_eq!(out.film.width(), 16);
+//! # Ok(()) }
+//! ```
 
-#[cfg(test)]
-mod tests {
-    use super::*;
+pub mod camera;
+pub mod film;
+pub mod optics;
+pub mod output;
+pub mod render;
+pub mod stats;
+pub mod whitted;
 
-    #[test]
-    fn it_works() {
-        let result = add(2, 2);
-        assert_eq!(result, 4);
-    }
+pub use camera::PinholeCamera;
+pub use film::Film;
+pub use output::{OutputError, OutputFormat, write_image};
+pub use render::{RenderError, RenderOutput, Renderer};
+pub use stats::{KindStats, RayKind, RenderStats};
+
+use englobe::{AccelKind, World, WorldError};
+use englobe_scene::Scene;
+
+/// The default scene: a few spheres on a plane, mirror and glass, two lights.
+pub const DEFAULT_SCENE: &str = include_str!("../../../scenes/default.toml");
+
+/// The world of a scene's objects, in the scene's order, under the structure `kind`.
+pub fn build_world(scene: &Scene, kind: AccelKind) -> Result<World, WorldError> {
+    World::build(scene.objects.iter().map(|o| o.object.clone()).collect(), kind)
 }

@@ -66,6 +66,13 @@ impl Counters for WorkCounts {
     }
 }
 
+impl From<NoCount> for WorkCounts {
+    /// Nothing was counted: zeros.
+    fn from(_: NoCount) -> Self {
+        WorkCounts::default()
+    }
+}
+
 impl AddAssign for WorkCounts {
     fn add_assign(&mut self, o: Self) {
         self.nodes_visited += o.nodes_visited;

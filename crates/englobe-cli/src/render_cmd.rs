@@ -1,0 +1,123 @@
+//! `englobe render`: one scene to one image, with optional statistics.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::time::Instant;
+
+use anyhow::Context;
+use clap::Args;
+use englobe::AccelKind;
+use englobe_render::{Renderer, build_world, write_image};
+use englobe_scene::{Scene, load_scene, parse_scene};
+
+use crate::progress::tile_bar;
+use crate::report::{StatsReport, stats_table, write_json};
+
+#[derive(Args)]
+pub struct RenderArgs {
+    /// Scene file (TOML, see docs/scene-format.md); the embedded default scene if omitted.
+    scene: Option<PathBuf>,
+    /// Output image (.png or .exr); defaults to the scene's name with .png, in the current folder.
+    #[arg(short, long)]
+    output: Option<PathBuf>,
+    /// Image width in pixels (overrides the scene).
+    #[arg(long)]
+    width: Option<u32>,
+    /// Image height in pixels (overrides the scene).
+    #[arg(long)]
+    height: Option<u32>,
+    /// Samples per pixel (overrides the scene).
+    #[arg(long)]
+    spp: Option<u32>,
+    /// Worker threads (default: all cores).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
+    threads: Option<u32>,
+    /// Acceleration structure.
+    #[arg(long, default_value = "none", value_parser = parse_accel)]
+    accel: AccelKind,
+    /// Print rays cast and exact intersection tests per kind of ray.
+    #[arg(long)]
+    stats: bool,
+    /// Write the statistics as JSON to this file.
+    #[arg(long, value_name = "FILE")]
+    stats_json: Option<PathBuf>,
+    /// No progress bar and no summary line.
+    #[arg(short, long)]
+    quiet: bool,
+}
+
+pub fn parse_accel(s: &str) -> Result<AccelKind, String> {
+    s.parse().map_err(|e: englobe::accel::UnknownAccel| e.to_string())
+}
+
+/// The scene of the command line, or the embedded default, with its display name.
+pub fn read_scene(path: Option<&PathBuf>) -> anyhow::Result<(Scene, String)> {
+    match path {
+        Some(p) => Ok((load_scene(p)?, p.display().to_string())),
+        None => Ok((parse_scene(englobe_render::DEFAULT_SCENE, "default.toml".as_ref())?, "default".to_owned())),
+    }
+}
+
+pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
+    let (scene, scene_name) = read_scene(args.scene.as_ref())?;
+    let width = args.width.unwrap_or(scene.image.width);
+    let height = args.height.unwrap_or(scene.image.height);
+    let samples = args.spp.unwrap_or(scene.image.samples);
+    let output = args.output.clone().unwrap_or_else(|| {
+        let stem = args.scene.as_ref().and_then(|p| p.file_stem()).map_or("englobe".into(), |s| s.to_os_string());
+        PathBuf::from(stem).with_extension("png")
+    });
+    englobe_render::OutputFormat::from_path(&output)?;
+
+    let build_start = Instant::now();
+    let world = build_world(&scene, args.accel).context("cannot build the acceleration structure")?;
+    let build_seconds = build_start.elapsed().as_secs_f64();
+
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(args.threads.map_or(0, |t| t as usize))
+        .build()
+        .context("cannot start the worker threads")?;
+    let count_work = args.stats || args.stats_json.is_some();
+    let tiles = width.div_ceil(englobe_render::render::TILE_SIZE) as usize
+        * height.div_ceil(englobe_render::render::TILE_SIZE) as usize;
+    let bar = tile_bar(tiles, args.quiet);
+    let progress = |done: usize, _total: usize| bar.set_position(done as u64);
+    let out = pool.install(|| {
+        Renderer::new(&scene, &world)
+            .size(width, height)
+            .samples(samples)
+            .count_work(count_work)
+            .on_progress(&progress)
+            .render()
+    })?;
+    bar.finish_and_clear();
+
+    write_image(&out.film, &output)?;
+    if !args.quiet {
+        println!(
+            "wrote {} ({width}x{height}, {samples} spp, accel {}, {:.2} s on {} threads)",
+            output.display(),
+            args.accel,
+            out.seconds,
+            pool.current_num_threads()
+        );
+    }
+    if args.stats {
+        print!("{}", stats_table(&out.stats));
+    }
+    if let Some(path) = &args.stats_json {
+        let report = StatsReport {
+            scene: &scene_name,
+            accel: args.accel.name(),
+            width,
+            height,
+            samples,
+            build_seconds,
+            render_seconds: out.seconds,
+            kinds: StatsReport::rows(&out.stats),
+            total: out.stats.total(),
+        };
+        write_json(path, &report)?;
+    }
+    Ok(ExitCode::SUCCESS)
+}

@@ -1,0 +1,66 @@
+//! Printing what a render counted: a table for people, JSON for programs.
+
+use std::path::Path;
+
+use anyhow::Context;
+use englobe_render::{KindStats, RayKind, RenderStats};
+use serde::Serialize;
+
+/// Everything `--stats-json` writes.
+#[derive(Serialize)]
+pub struct StatsReport<'a> {
+    pub scene: &'a str,
+    pub accel: &'a str,
+    pub width: u32,
+    pub height: u32,
+    pub samples: u32,
+    pub build_seconds: f64,
+    pub render_seconds: f64,
+    pub kinds: Vec<KindRow>,
+    pub total: KindStats,
+}
+
+#[derive(Serialize)]
+pub struct KindRow {
+    pub kind: RayKind,
+    #[serde(flatten)]
+    pub stats: KindStats,
+}
+
+impl<'a> StatsReport<'a> {
+    pub fn rows(stats: &RenderStats) -> Vec<KindRow> {
+        RayKind::ALL.iter().map(|&kind| KindRow { kind, stats: *stats.kind(kind) }).collect()
+    }
+}
+
+/// The table `--stats` prints.
+pub fn stats_table(stats: &RenderStats) -> String {
+    let mut out = format!(
+        "{:<10} {:>14} {:>16} {:>10} {:>16} {:>16}\n",
+        "ray kind", "rays", "exact tests", "tests/ray", "nodes visited", "box tests"
+    );
+    let line = |name: &str, k: &KindStats| {
+        let per_ray = if k.rays == 0 { 0.0 } else { k.exact_tests as f64 / k.rays as f64 };
+        format!(
+            "{:<10} {:>14} {:>16} {:>10.2} {:>16} {:>16}\n",
+            name, k.rays, k.exact_tests, per_ray, k.nodes_visited, k.box_tests
+        )
+    };
+    for kind in RayKind::ALL {
+        out += &line(kind.name(), stats.kind(kind));
+    }
+    out += &line("total", &stats.total());
+    out
+}
+
+/// Writes `value` as pretty JSON to `path`, atomically.
+pub fn write_json(path: &Path, value: &impl Serialize) -> anyhow::Result<()> {
+    let text = serde_json::to_string_pretty(value).context("cannot serialise the statistics")?;
+    englobe_render::output::write_atomically(path, |w| {
+        use std::io::Write;
+        w.write_all(text.as_bytes())
+            .and_then(|_| w.write_all(b"\n"))
+            .map_err(|source| englobe_render::OutputError::Io { path: path.to_owned(), source })
+    })?;
+    Ok(())
+}

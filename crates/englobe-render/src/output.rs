@@ -1,0 +1,134 @@
+//! Writing images: PNG (8-bit sRGB) or OpenEXR (linear float), always atomically: the image is
+//! written to a temporary file in the destination's folder and renamed over the destination, so
+//! an interrupted run never leaves a half-written file where a good image was.
+
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+
+use image::{ImageFormat, Rgb32FImage, RgbImage};
+
+use crate::film::Film;
+
+/// Why an image could not be written.
+#[derive(Debug, thiserror::Error)]
+pub enum OutputError {
+    /// The extension is neither `.png` nor `.exr`.
+    #[error("{}: unsupported image format; expected a file name ending in .png or .exr", .0.display())]
+    UnknownFormat(PathBuf),
+    /// The file system refused.
+    #[error("{}: cannot write: {source}", path.display())]
+    Io {
+        /// The destination.
+        path: PathBuf,
+        /// The cause.
+        #[source]
+        source: std::io::Error,
+    },
+    /// The encoder failed.
+    #[error("{}: cannot encode: {source}", path.display())]
+    Encode {
+        /// The destination.
+        path: PathBuf,
+        /// The cause.
+        #[source]
+        source: image::ImageError,
+    },
+}
+
+/// The image formats englobe writes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum OutputFormat {
+    /// 8-bit sRGB PNG.
+    Png,
+    /// 32-bit float linear OpenEXR.
+    Exr,
+}
+
+impl OutputFormat {
+    /// The format for a file name, from its extension.
+    pub fn from_path(path: &Path) -> Result<Self, OutputError> {
+        match path.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase()).as_deref() {
+            Some("png") => Ok(OutputFormat::Png),
+            Some("exr") => Ok(OutputFormat::Exr),
+            _ => Err(OutputError::UnknownFormat(path.to_owned())),
+        }
+    }
+}
+
+/// Writes the film to `path` (format from the extension), atomically.
+pub fn write_image(film: &Film, path: &Path) -> Result<(), OutputError> {
+    let format = OutputFormat::from_path(path)?;
+    write_atomically(path, |w| {
+        let (wd, ht) = (film.width(), film.height());
+        let result = match format {
+            OutputFormat::Png => RgbImage::from_raw(wd, ht, film.to_srgb8())
+                .expect("the film holds exactly width * height pixels")
+                .write_to(w, ImageFormat::Png),
+            OutputFormat::Exr => Rgb32FImage::from_raw(wd, ht, film.to_linear_f32())
+                .expect("the film holds exactly width * height pixels")
+                .write_to(w, ImageFormat::OpenExr),
+        };
+        result.map_err(|source| OutputError::Encode { path: path.to_owned(), source })
+    })
+}
+
+/// Runs `write` on a temporary file beside `path`, then renames it to `path`. On any error the
+/// temporary file is removed and `path` is left as it was.
+pub fn write_atomically(
+    path: &Path,
+    write: impl FnOnce(&mut BufWriter<&mut std::fs::File>) -> Result<(), OutputError>,
+) -> Result<(), OutputError> {
+    let io = |source| OutputError::Io { path: path.to_owned(), source };
+    let dir = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    let mut tmp = tempfile::Builder::new().prefix(".englobe-").suffix(".tmp").tempfile_in(dir).map_err(io)?;
+    {
+        let mut w = BufWriter::new(tmp.as_file_mut());
+        write(&mut w)?;
+        w.flush().map_err(io)?;
+    }
+    tmp.as_file().sync_all().map_err(io)?;
+    tmp.persist(path).map_err(|e| io(e.error))?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn png_round_trips_and_replaces_atomically() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("out.png");
+        let mut film = Film::new(3, 2);
+        film.set(1, 0, englobe::Vec3::new(1.0, 0.0, 0.0));
+        write_image(&film, &path).unwrap();
+        let img = image::open(&path).unwrap().to_rgb8();
+        assert_eq!(img.dimensions(), (3, 2));
+        assert_eq!(img.get_pixel(1, 0).0, [255, 0, 0]);
+        // A failed write leaves the good image and no temporary file behind.
+        let err = write_atomically(&path, |_| Err(OutputError::UnknownFormat(path.clone())));
+        assert!(err.is_err());
+        assert_eq!(image::open(&path).unwrap().to_rgb8(), img);
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+    }
+
+    #[test]
+    fn exr_round_trips_linear_values() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("out.exr");
+        let mut film = Film::new(2, 2);
+        film.set(0, 1, englobe::Vec3::new(4.5, 0.25, 0.0));
+        write_image(&film, &path).unwrap();
+        let img = image::open(&path).unwrap().to_rgb32f();
+        assert_eq!(img.get_pixel(0, 1).0, [4.5, 0.25, 0.0]);
+    }
+
+    #[test]
+    fn unknown_extension_is_refused() {
+        let e = write_image(&Film::new(1, 1), Path::new("x.jpg")).unwrap_err();
+        assert!(e.to_string().contains(".png or .exr"), "{e}");
+    }
+}

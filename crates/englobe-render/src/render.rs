@@ -1,0 +1,182 @@
+//! Rendering an image: the film is cut into square tiles that rayon's workers take in any order;
+//! every pixel draws its samples from a generator seeded by the scene's seed and the pixel's
+//! position alone, and tiles are stitched back in a fixed order, so the image bytes and the
+//! counts are the same on 1 thread or many.
+
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::time::Instant;
+
+use englobe::{Counters, NoCount, Vec3, WorkCounts, World};
+use englobe_scene::{ImageSettings, Scene};
+use rand::{RngExt, SeedableRng};
+use rand_pcg::Pcg32;
+use rayon::prelude::*;
+
+use crate::camera::PinholeCamera;
+use crate::film::Film;
+use crate::stats::{RayKind, RenderStats, Tally};
+use crate::whitted::Whitted;
+
+/// Side of the square tiles, in pixels.
+pub const TILE_SIZE: u32 = 32;
+
+/// Why a render could not start.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum RenderError {
+    /// Size, samples or depth out of range (checked before anything is allocated).
+    #[error("{0}")]
+    Limits(String),
+}
+
+/// What a render produced.
+#[derive(Clone, Debug)]
+pub struct RenderOutput {
+    /// The image.
+    pub film: Film,
+    /// Rays and work per kind of ray (work is zero unless counting was asked for).
+    pub stats: RenderStats,
+    /// False if the render was cancelled before every tile was done (missing tiles are black).
+    pub complete: bool,
+    /// Wall-clock seconds spent rendering.
+    pub seconds: f64,
+}
+
+/// Renders a scene through its world: `Renderer::new(&scene, &world).size(640, 480).render()`.
+pub struct Renderer<'a> {
+    scene: &'a Scene,
+    world: &'a World,
+    width: u32,
+    height: u32,
+    samples: u32,
+    count_work: bool,
+    progress: Option<&'a (dyn Fn(usize, usize) + Sync)>,
+    cancel: Option<&'a AtomicBool>,
+}
+
+impl<'a> Renderer<'a> {
+    /// A renderer with the scene's own image settings. `world` must hold the scene's objects in
+    /// order (see [`crate::build_world`]).
+    pub fn new(scene: &'a Scene, world: &'a World) -> Self {
+        let ImageSettings { width, height, samples, .. } = scene.image;
+        Renderer { scene, world, width, height, samples, count_work: false, progress: None, cancel: None }
+    }
+
+    /// Overrides the image size.
+    pub fn size(mut self, width: u32, height: u32) -> Self {
+        self.width = width;
+        self.height = height;
+        self
+    }
+
+    /// Overrides the samples per pixel.
+    pub fn samples(mut self, samples: u32) -> Self {
+        self.samples = samples;
+        self
+    }
+
+    /// Counts the structure's work (nodes, box tests, exact tests) per kind of ray. Off by
+    /// default: the uncounted render compiles the counters away.
+    pub fn count_work(mut self, on: bool) -> Self {
+        self.count_work = on;
+        self
+    }
+
+    /// Calls `f(tiles_done, tiles_total)` after every tile, from any worker thread.
+    pub fn on_progress(mut self, f: &'a (dyn Fn(usize, usize) + Sync)) -> Self {
+        self.progress = Some(f);
+        self
+    }
+
+    /// Stops starting new tiles once `flag` is set; the output then says it is incomplete.
+    pub fn cancel_flag(mut self, flag: &'a AtomicBool) -> Self {
+        self.cancel = Some(flag);
+        self
+    }
+
+    /// Renders on the current rayon thread pool.
+    pub fn render(&self) -> Result<RenderOutput, RenderError> {
+        ImageSettings::check_limits(self.width, self.height, self.samples, self.scene.image.max_depth)
+            .map_err(RenderError::Limits)?;
+        if self.count_work { Ok(self.render_with::<WorkCounts>()) } else { Ok(self.render_with::<NoCount>()) }
+    }
+
+    fn render_with<C: Counters + Copy + Send + Into<WorkCounts>>(&self) -> RenderOutput {
+        let start = Instant::now();
+        let camera = PinholeCamera::new(&self.scene.camera, self.width, self.height);
+        let integrator = Whitted::new(self.scene, self.world);
+        let tiles_x = self.width.div_ceil(TILE_SIZE);
+        let tiles_y = self.height.div_ceil(TILE_SIZE);
+        let total = (tiles_x * tiles_y) as usize;
+        let done = AtomicUsize::new(0);
+
+        let tiles: Vec<Option<(Vec<Vec3>, RenderStats)>> = (0..total)
+            .into_par_iter()
+            .map(|index| {
+                if self.cancel.is_some_and(|c| c.load(Ordering::Relaxed)) {
+                    return None;
+                }
+                let (x0, y0) = ((index as u32 % tiles_x) * TILE_SIZE, (index as u32 / tiles_x) * TILE_SIZE);
+                let (x1, y1) = ((x0 + TILE_SIZE).min(self.width), (y0 + TILE_SIZE).min(self.height));
+                let mut tally = Tally::<C>::default();
+                let mut pixels = Vec::with_capacity(((x1 - x0) * (y1 - y0)) as usize);
+                for y in y0..y1 {
+                    for x in x0..x1 {
+                        pixels.push(self.pixel(&camera, &integrator, x, y, &mut tally));
+                    }
+                }
+                let n = done.fetch_add(1, Ordering::Relaxed) + 1;
+                if let Some(progress) = self.progress {
+                    progress(n, total);
+                }
+                Some((pixels, tally.stats()))
+            })
+            .collect();
+
+        let mut film = Film::new(self.width, self.height);
+        let mut stats = RenderStats::default();
+        let mut complete = true;
+        for (index, tile) in tiles.into_iter().enumerate() {
+            let Some((pixels, tile_stats)) = tile else {
+                complete = false;
+                continue;
+            };
+            stats.add(&tile_stats);
+            let (x0, y0) = ((index as u32 % tiles_x) * TILE_SIZE, (index as u32 / tiles_x) * TILE_SIZE);
+            let x1 = (x0 + TILE_SIZE).min(self.width);
+            let mut it = pixels.into_iter();
+            for y in y0..(y0 + TILE_SIZE).min(self.height) {
+                for x in x0..x1 {
+                    film.set(x, y, it.next().expect("a tile holds all its pixels"));
+                }
+            }
+        }
+        RenderOutput { film, stats, complete, seconds: start.elapsed().as_secs_f64() }
+    }
+
+    fn pixel<C: Counters>(
+        &self,
+        camera: &PinholeCamera,
+        integrator: &Whitted,
+        x: u32,
+        y: u32,
+        tally: &mut Tally<C>,
+    ) -> Vec3 {
+        if self.samples == 1 {
+            let ray = camera.ray(x as f32 + 0.5, y as f32 + 0.5);
+            return integrator.radiance(&ray, RayKind::Primary, 0, tally);
+        }
+        let mut rng = pixel_rng(self.scene.image.seed, x, y);
+        let mut sum = Vec3::ZERO;
+        for _ in 0..self.samples {
+            let (dx, dy): (f32, f32) = (rng.random(), rng.random());
+            let ray = camera.ray(x as f32 + dx, y as f32 + dy);
+            sum += integrator.radiance(&ray, RayKind::Primary, 0, tally);
+        }
+        sum / self.samples as f32
+    }
+}
+
+/// The sample generator of one pixel: depends on the seed and the pixel only, never on threads.
+pub fn pixel_rng(seed: u64, x: u32, y: u32) -> Pcg32 {
+    Pcg32::seed_from_u64(seed ^ ((y as u64) << 32 | x as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15))
+}

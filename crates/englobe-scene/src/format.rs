@@ -1,0 +1,134 @@
+//! The scene file as written: serde structures mirroring the TOML, documented key by key in
+//! `docs/scene-format.md`. Every table refuses unknown keys, and every number is checked as it is
+//! read (see [`crate::numbers`]) so that errors point at the offending value.
+
+use std::collections::BTreeMap;
+
+use serde::Deserialize;
+use toml::Spanned;
+
+use crate::numbers::{Color, Finite, Fraction, NonNegative, Point, Positive};
+
+/// A whole scene file.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneFile {
+    pub image: Spanned<ImageDef>,
+    pub camera: Spanned<CameraDef>,
+    #[serde(default)]
+    pub materials: BTreeMap<String, Spanned<MaterialDef>>,
+    #[serde(default)]
+    pub point_light: Vec<PointLightDef>,
+    #[serde(default)]
+    pub directional_light: Vec<DirectionalLightDef>,
+    #[serde(default)]
+    pub sphere: Vec<SphereDef>,
+    #[serde(default)]
+    pub sphere_grid: Vec<Spanned<SphereGridDef>>,
+    #[serde(default)]
+    pub plane: Vec<PlaneDef>,
+    #[serde(default, rename = "box")]
+    pub boxes: Vec<Spanned<BoxDef>>,
+    #[serde(default)]
+    pub triangle: Vec<Spanned<TriangleDef>>,
+}
+
+fn one() -> u32 {
+    1
+}
+fn five() -> u32 {
+    5
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ImageDef {
+    pub width: Spanned<u32>,
+    pub height: Spanned<u32>,
+    #[serde(default = "one")]
+    pub samples: u32,
+    #[serde(default = "five")]
+    pub max_depth: u32,
+    pub background: Option<Color>,
+    pub ambient: Option<Color>,
+    #[serde(default)]
+    pub seed: u64,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CameraDef {
+    pub position: Point,
+    pub look_at: Spanned<Point>,
+    pub up: Option<Spanned<Point>>,
+    pub fov: Option<Spanned<Finite>>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MaterialDef {
+    pub diffuse: Option<Color>,
+    pub specular: Option<Color>,
+    pub shininess: Option<NonNegative>,
+    pub reflectivity: Option<Fraction>,
+    pub transparency: Option<Fraction>,
+    pub ior: Option<Positive>,
+    pub emission: Option<Color>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PointLightDef {
+    pub position: Point,
+    pub color: Option<Color>,
+    pub intensity: Option<NonNegative>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DirectionalLightDef {
+    pub direction: Spanned<Point>,
+    pub color: Option<Color>,
+    pub intensity: Option<NonNegative>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SphereDef {
+    pub center: Point,
+    pub radius: Positive,
+    pub material: Option<Spanned<String>>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SphereGridDef {
+    pub origin: Point,
+    pub spacing: Point,
+    pub counts: [u32; 3],
+    pub radius: Positive,
+    pub material: Option<Spanned<String>>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PlaneDef {
+    pub point: Point,
+    pub normal: Spanned<Point>,
+    pub material: Option<Spanned<String>>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BoxDef {
+    pub min: Point,
+    pub max: Point,
+    pub material: Option<Spanned<String>>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TriangleDef {
+    pub vertices: [Point; 3],
+    pub material: Option<Spanned<String>>,
+}

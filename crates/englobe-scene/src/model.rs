@@ -1,0 +1,146 @@
+//! The validated scene, as the renderer receives it. Everything here has been checked: sizes are
+//! within limits, numbers are finite, the camera is not degenerate and every object's material
+//! exists.
+
+use englobe::{Object, Vec3};
+
+/// Largest image, in pixels (2^28: a 16384 x 16384 image), refused before anything is allocated.
+pub const MAX_PIXELS: u64 = 1 << 28;
+/// Most samples per pixel.
+pub const MAX_SAMPLES: u32 = 1 << 16;
+/// Deepest recursion of secondary rays.
+pub const MAX_DEPTH: u32 = 64;
+
+/// Image and integrator settings.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ImageSettings {
+    /// Width in pixels, at least 1.
+    pub width: u32,
+    /// Height in pixels, at least 1.
+    pub height: u32,
+    /// Samples per pixel: 1 shoots through pixel centres; more jitters them over the pixel.
+    pub samples: u32,
+    /// Maximum number of reflection/refraction bounces after the primary ray.
+    pub max_depth: u32,
+    /// Colour of rays that hit nothing (linear RGB).
+    pub background: Vec3,
+    /// Light that reaches every point, scaled by the diffuse colour (the classic ambient term).
+    pub ambient: Vec3,
+    /// Seed of the pixel sampler; the same seed gives the same image.
+    pub seed: u64,
+}
+
+impl ImageSettings {
+    /// Checks the size, sample count and depth against the limits above.
+    pub fn check_limits(width: u32, height: u32, samples: u32, max_depth: u32) -> Result<(), String> {
+        if width == 0 || height == 0 {
+            return Err(format!("image size {width}x{height}: width and height must be at least 1"));
+        }
+        let pixels = width as u64 * height as u64;
+        if pixels > MAX_PIXELS {
+            return Err(format!("image size {width}x{height} is {pixels} pixels, more than the limit of {MAX_PIXELS}"));
+        }
+        if samples == 0 || samples > MAX_SAMPLES {
+            return Err(format!("{samples} samples per pixel: expected 1 to {MAX_SAMPLES}"));
+        }
+        if max_depth > MAX_DEPTH {
+            return Err(format!("maximum depth {max_depth}: expected 0 to {MAX_DEPTH}"));
+        }
+        Ok(())
+    }
+}
+
+/// A pinhole perspective camera.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Camera {
+    /// Eye position.
+    pub position: Vec3,
+    /// Point the camera looks at (distinct from `position`).
+    pub look_at: Vec3,
+    /// Up direction (not parallel to the view direction).
+    pub up: Vec3,
+    /// Vertical field of view, in degrees, in `(0, 180)`.
+    pub fov_degrees: f32,
+}
+
+/// A light source.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Light {
+    /// Light from one point, falling off with the square of the distance.
+    Point {
+        /// Position.
+        position: Vec3,
+        /// Colour times intensity (linear RGB).
+        power: Vec3,
+    },
+    /// Parallel light from infinitely far away, such as the sun.
+    Directional {
+        /// Unit direction the light travels in.
+        direction: Vec3,
+        /// Colour times intensity.
+        radiance: Vec3,
+    },
+}
+
+/// Surface appearance: a Phong-style local model plus Whitted's mirror and glass terms.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Material {
+    /// Diffuse (Lambert) colour.
+    pub diffuse: Vec3,
+    /// Specular highlight colour (Blinn-Phong).
+    pub specular: Vec3,
+    /// Blinn-Phong exponent.
+    pub shininess: f32,
+    /// Fraction of light mirrored, in `0..=1`.
+    pub reflectivity: f32,
+    /// Fraction of light transmitted, in `0..=1`; `reflectivity + transparency <= 1`.
+    pub transparency: f32,
+    /// Index of refraction of the inside of a transparent object.
+    pub ior: f32,
+    /// Light emitted by the surface itself.
+    pub emission: Vec3,
+}
+
+impl Default for Material {
+    /// A matte light grey.
+    fn default() -> Self {
+        Material {
+            diffuse: Vec3::splat(0.7),
+            specular: Vec3::ZERO,
+            shininess: 32.0,
+            reflectivity: 0.0,
+            transparency: 0.0,
+            ior: 1.5,
+            emission: Vec3::ZERO,
+        }
+    }
+}
+
+/// Index into [`Scene::materials`].
+pub type MaterialId = u32;
+
+/// An object of the scene with its appearance.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SceneObject {
+    /// The geometry.
+    pub object: Object,
+    /// Its material.
+    pub material: MaterialId,
+}
+
+/// A complete, validated scene.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Scene {
+    /// Image and integrator settings.
+    pub image: ImageSettings,
+    /// The camera.
+    pub camera: Camera,
+    /// Light sources.
+    pub lights: Vec<Light>,
+    /// Materials, indexed by [`MaterialId`].
+    pub materials: Vec<Material>,
+    /// Material names, parallel to `materials`.
+    pub material_names: Vec<String>,
+    /// Objects.
+    pub objects: Vec<SceneObject>,
+}

@@ -1,0 +1,241 @@
+//! From scene text to a validated [`Scene`]: parse the TOML into [`crate::format`], then check
+//! what a single value cannot say on its own (the camera, cross references, limits) and build the
+//! objects.
+
+use std::collections::BTreeMap;
+use std::ops::Range;
+use std::path::Path;
+
+use englobe::{AaBox, Object, Plane, Sphere, Triangle, Vec3};
+use toml::Spanned;
+
+use crate::error::SceneError;
+use crate::format::{CameraDef, ImageDef, MaterialDef, SceneFile};
+use crate::model::{Camera, ImageSettings, Light, Material, MaterialId, Scene, SceneObject};
+
+/// Name of the material objects get when they name none.
+pub const DEFAULT_MATERIAL: &str = "default";
+/// Most spheres one `[[sphere_grid]]` may generate.
+pub const MAX_GRID_SPHERES: u64 = 1 << 24;
+/// Largest scene file read.
+pub const MAX_SCENE_BYTES: u64 = 64 << 20;
+
+/// Reads and validates the scene file at `path`.
+pub fn load_scene(path: &Path) -> Result<Scene, SceneError> {
+    let meta = std::fs::metadata(path).map_err(|e| SceneError::io(path, e))?;
+    if meta.is_dir() {
+        return Err(SceneError::io(path, std::io::Error::other("is a directory, expected a scene file")));
+    }
+    if meta.len() > MAX_SCENE_BYTES {
+        return Err(SceneError::io(
+            path,
+            std::io::Error::other(format!("{} bytes is larger than the {MAX_SCENE_BYTES}-byte limit", meta.len())),
+        ));
+    }
+    let bytes = std::fs::read(path).map_err(|e| SceneError::io(path, e))?;
+    let text = String::from_utf8(bytes).map_err(|e| {
+        let at = e.utf8_error().valid_up_to();
+        SceneError::at(&path.display().to_string(), "", None, format!("byte {at}: the file is not valid UTF-8"))
+    })?;
+    parse_scene(&text, path)
+}
+
+/// Validates scene `text`; `file` names it in errors.
+pub fn parse_scene(text: &str, file: &Path) -> Result<Scene, SceneError> {
+    let name = file.display().to_string();
+    let def: SceneFile =
+        toml::from_str(text).map_err(|e| SceneError::at(&name, text, e.span(), e.message().to_owned()))?;
+    Converter { file: &name, text }.scene(def)
+}
+
+struct Converter<'a> {
+    file: &'a str,
+    text: &'a str,
+}
+
+impl Converter<'_> {
+    fn err(&self, span: Range<usize>, message: impl Into<String>) -> SceneError {
+        SceneError::at(self.file, self.text, Some(span), message)
+    }
+
+    fn scene(&self, def: SceneFile) -> Result<Scene, SceneError> {
+        let image = self.image(def.image)?;
+        let camera = self.camera(def.camera)?;
+        let (materials, material_names) = self.materials(def.materials)?;
+        let lookup = |m: &Option<Spanned<String>>| -> Result<MaterialId, SceneError> {
+            let Some(m) = m else { return Ok(0) };
+            material_names.iter().position(|n| n == m.get_ref()).map(|i| i as MaterialId).ok_or_else(|| {
+                let known = material_names.join(", ");
+                self.err(m.span(), format!("unknown material `{}`; the scene defines: {known}", m.get_ref()))
+            })
+        };
+
+        let mut lights = Vec::new();
+        for l in def.point_light {
+            lights.push(Light::Point { position: l.position.0, power: light_power(l.color, l.intensity) });
+        }
+        for l in def.directional_light {
+            let Some(direction) = l.direction.get_ref().0.try_normalize() else {
+                return Err(self.err(l.direction.span(), "a directional light needs a non-zero direction"));
+            };
+            lights.push(Light::Directional { direction, radiance: light_power(l.color, l.intensity) });
+        }
+
+        let mut objects = Vec::new();
+        let mut push = |object: Object, material| objects.push(SceneObject { object, material });
+        for s in def.sphere {
+            push(Sphere::new(s.center.0, s.radius.0).into(), lookup(&s.material)?);
+        }
+        for grid in def.sphere_grid {
+            let span = grid.span();
+            let g = grid.into_inner();
+            let total = g.counts.iter().map(|&c| c as u64).product::<u64>();
+            if total > MAX_GRID_SPHERES {
+                return Err(
+                    self.err(span, format!("a sphere grid of {total} spheres is over the limit of {MAX_GRID_SPHERES}"))
+                );
+            }
+            let material = lookup(&g.material)?;
+            for k in 0..g.counts[2] {
+                for j in 0..g.counts[1] {
+                    for i in 0..g.counts[0] {
+                        let center = g.origin.0 + g.spacing.0 * Vec3::new(i as f32, j as f32, k as f32);
+                        if !center.is_finite() {
+                            return Err(self.err(span, "the sphere grid reaches beyond what 32-bit floats can hold"));
+                        }
+                        push(Sphere::new(center, g.radius.0).into(), material);
+                    }
+                }
+            }
+        }
+        for p in def.plane {
+            let Some(plane) = Plane::new(p.normal.get_ref().0, p.point.0) else {
+                return Err(self.err(p.normal.span(), "a plane needs a non-zero normal"));
+            };
+            push(plane.into(), lookup(&p.material)?);
+        }
+        for b in def.boxes {
+            let span = b.span();
+            let b = b.into_inner();
+            if !b.min.0.cmplt(b.max.0).all() {
+                return Err(self.err(
+                    span,
+                    format!("a box needs min < max on every axis, found min {} and max {}", b.min.0, b.max.0),
+                ));
+            }
+            push(AaBox::new(b.min.0, b.max.0).into(), lookup(&b.material)?);
+        }
+        for t in def.triangle {
+            let span = t.span();
+            let t = t.into_inner();
+            let tri = Triangle::new(t.vertices[0].0, t.vertices[1].0, t.vertices[2].0);
+            if !(tri.double_area() > 0.0) {
+                return Err(
+                    self.err(span, "a triangle needs three vertices that are not on one line (its area is zero)")
+                );
+            }
+            push(tri.into(), lookup(&t.material)?);
+        }
+        Ok(Scene { image, camera, lights, materials, material_names, objects })
+    }
+
+    fn image(&self, image: Spanned<ImageDef>) -> Result<ImageSettings, SceneError> {
+        let span = image.span();
+        let i = image.into_inner();
+        let (width, height) = (*i.width.get_ref(), *i.height.get_ref());
+        ImageSettings::check_limits(width, height, i.samples, i.max_depth).map_err(|message| {
+            let at = if width == 0 || width as u64 * height as u64 > crate::model::MAX_PIXELS {
+                i.width.span()
+            } else if height == 0 {
+                i.height.span()
+            } else {
+                span
+            };
+            self.err(at, message)
+        })?;
+        Ok(ImageSettings {
+            width,
+            height,
+            samples: i.samples,
+            max_depth: i.max_depth,
+            background: i.background.map_or(Vec3::ZERO, |c| c.0),
+            ambient: i.ambient.map_or(Vec3::ZERO, |c| c.0),
+            seed: i.seed,
+        })
+    }
+
+    fn camera(&self, camera: Spanned<CameraDef>) -> Result<Camera, SceneError> {
+        let span = camera.span();
+        let c = camera.into_inner();
+        let position = c.position.0;
+        let look_at = c.look_at.get_ref().0;
+        let view = look_at - position;
+        if !(view.length() > 0.0) || !view.is_finite() {
+            return Err(self.err(c.look_at.span(), "the camera's look_at must differ from its position"));
+        }
+        let (up, up_span) = match &c.up {
+            Some(u) => (u.get_ref().0, u.span()),
+            None => (Vec3::Y, span.clone()),
+        };
+        let side = view.normalize().cross(up.normalize_or_zero());
+        if !(side.length() > 1e-6) {
+            return Err(self.err(
+                up_span,
+                format!("the camera's up vector {up} is zero or parallel to its view direction {view}"),
+            ));
+        }
+        let fov_degrees = match &c.fov {
+            Some(f) if !(f.get_ref().0 > 0.0 && f.get_ref().0 < 180.0) => {
+                return Err(self.err(
+                    f.span(),
+                    format!("a field of view of {} degrees: expected more than 0 and less than 180", f.get_ref().0),
+                ));
+            }
+            Some(f) => f.get_ref().0,
+            None => 45.0,
+        };
+        Ok(Camera { position, look_at, up, fov_degrees })
+    }
+
+    fn materials(
+        &self,
+        defs: BTreeMap<String, Spanned<MaterialDef>>,
+    ) -> Result<(Vec<Material>, Vec<String>), SceneError> {
+        let mut materials = vec![Material::default()];
+        let mut names = vec![DEFAULT_MATERIAL.to_owned()];
+        for (name, def) in defs {
+            let span = def.span();
+            let d = def.into_inner();
+            let base = Material::default();
+            let m = Material {
+                diffuse: d.diffuse.map_or(base.diffuse, |c| c.0),
+                specular: d.specular.map_or(base.specular, |c| c.0),
+                shininess: d.shininess.map_or(base.shininess, |x| x.0),
+                reflectivity: d.reflectivity.map_or(base.reflectivity, |x| x.0),
+                transparency: d.transparency.map_or(base.transparency, |x| x.0),
+                ior: d.ior.map_or(base.ior, |x| x.0),
+                emission: d.emission.map_or(base.emission, |c| c.0),
+            };
+            if m.reflectivity + m.transparency > 1.0 {
+                return Err(self.err(
+                    span,
+                    format!(
+                        "material `{name}`: reflectivity + transparency is {}, expected at most 1",
+                        m.reflectivity + m.transparency
+                    ),
+                ));
+            }
+            if name == DEFAULT_MATERIAL {
+                materials[0] = m;
+            } else {
+                materials.push(m);
+                names.push(name);
+            }
+        }
+        Ok((materials, names))
+    }
+}
+
+fn light_power(color: Option<crate::numbers::Color>, intensity: Option<crate::numbers::NonNegative>) -> Vec3 {
+    color.map_or(Vec3::ONE, |c| c.0) * intensity.map_or(1.0, |i| i.0)
+}
