@@ -70,7 +70,8 @@ mod tests {
         assert_eq!(encode_srgb8(7.0), 255);
         assert_eq!(encode_srgb8(-1.0), 0);
         assert_eq!(encode_srgb8(f32::NAN), 0);
-        // Linear 0.2140 is sRGB 128/255 (the standard's mid grey).
-        assert_eq!(encode_srgb8(0.2140), 128);
+        // sRGB 128/255 is linear ((128/255 + 0.055) / 1.055)^2.4 = 0.2158.
+        assert_eq!(encode_srgb8(0.2158), 128);
+        assert_eq!(encode_srgb8(0.2140), 127);
     }
 }

@@ -57,9 +57,11 @@ impl<'a> Whitted<'a> {
         for light in &self.scene.lights {
             let (shadow_ray, to_light, radiance) = match *light {
                 Light::Point { position, power } => {
-                    let v = position - lit_side;
+                    // Shading uses the true point; only the shadow ray starts off the surface.
+                    let v = position - p;
                     let dist2 = v.length_squared();
-                    (Ray::segment(lit_side, v, 0.0, SHADOW_RAY_END), v / dist2.sqrt(), power / dist2)
+                    let shadow = Ray::segment(lit_side, position - lit_side, 0.0, SHADOW_RAY_END);
+                    (shadow, v / dist2.sqrt(), power / dist2)
                 }
                 Light::Directional { direction, radiance } => (Ray::new(lit_side, -direction), -direction, radiance),
             };

@@ -29,3 +29,8 @@ pub use glam::{Vec2, Vec3};
 pub use ray::Ray;
 pub use shapes::{AaBox, Bounded, Intersect, Plane, PrimHit, Shape, Sphere, Triangle, TriangleMesh};
 pub use world::{Object, World, WorldError, WorldHit};
+
+// The README's examples are compiled and run as doctests.
+#[cfg(doctest)]
+#[doc = include_str!("../../../README.md")]
+struct ReadmeDoctests;

@@ -1,0 +1,169 @@
+//! End-to-end runs of `englobe render`: the default scene, statistics, thread independence, and
+//! every kind of bad input refused with a located error and a non-zero exit.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn englobe(dir: &Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_englobe")).args(args).current_dir(dir).output().expect("englobe runs")
+}
+
+fn stdout(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+fn repo_root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+#[test]
+fn render_with_no_arguments_writes_the_default_scene_and_says_where() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = englobe(dir.path(), &["render"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(stdout(&out).starts_with("wrote englobe.png (640x480"), "{}", stdout(&out));
+    let img = image::open(dir.path().join("englobe.png")).unwrap();
+    assert_eq!((img.width(), img.height()), (640, 480));
+}
+
+#[test]
+fn stats_table_and_json() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = englobe(
+        dir.path(),
+        &[
+            "render",
+            "--width",
+            "40",
+            "--height",
+            "30",
+            "--spp",
+            "1",
+            "--stats",
+            "--stats-json",
+            "s.json",
+            "-o",
+            "a.png",
+        ],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = stdout(&out);
+    for row in ["primary", "shadow", "reflected", "refracted", "total"] {
+        assert!(text.lines().any(|l| l.starts_with(row)), "no `{row}` row in:\n{text}");
+    }
+    let primary: Vec<&str> = text.lines().find(|l| l.starts_with("primary")).unwrap().split_whitespace().collect();
+    assert_eq!(primary[1], "1200", "40 x 30 primary rays");
+    assert_eq!(primary[2], "7200", "6 objects tested per primary ray by brute force");
+
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("s.json")).unwrap()).unwrap();
+    assert_eq!(json["accel"], "none");
+    assert_eq!(json["kinds"][0]["kind"], "primary");
+    assert_eq!(json["kinds"][0]["rays"], 1200);
+    assert_eq!(json["kinds"][0]["exact_tests"], 7200);
+    assert!(json["total"]["rays"].as_u64().unwrap() > 1200);
+}
+
+#[test]
+fn one_and_two_threads_write_identical_bytes() {
+    let dir = tempfile::tempdir().unwrap();
+    let common = ["render", "--width", "64", "--height", "48", "--spp", "2", "--quiet"];
+    let one = englobe(dir.path(), &[&common[..], &["--threads", "1", "-o", "one.png"]].concat());
+    let two = englobe(dir.path(), &[&common[..], &["--threads", "2", "-o", "two.png"]].concat());
+    assert!(one.status.success() && two.status.success());
+    assert!(stdout(&one).is_empty(), "--quiet prints nothing");
+    let a = std::fs::read(dir.path().join("one.png")).unwrap();
+    let b = std::fs::read(dir.path().join("two.png")).unwrap();
+    assert_eq!(a, b);
+}
+
+#[test]
+fn example_scenes_render_with_statistics() {
+    let dir = tempfile::tempdir().unwrap();
+    let scenes = repo_root().join("scenes");
+    for name in ["default.toml", "glass.toml", "mirrors.toml"] {
+        let path = scenes.join(name);
+        let out =
+            englobe(dir.path(), &["render", path.to_str().unwrap(), "--width", "48", "--height", "36", "--stats"]);
+        assert!(out.status.success(), "{name}: {}", stderr(&out));
+        assert!(stdout(&out).contains("exact tests"), "{name}");
+        let png = PathBuf::from(name).with_extension("png");
+        assert!(dir.path().join(png).exists(), "{name}: the image is named after the scene");
+    }
+}
+
+/// Bad scene files: each must exit non-zero with `bad.toml:LINE:COLUMN:` and the expectation.
+#[test]
+fn bad_scenes_fail_with_file_line_and_column() {
+    let good = std::fs::read_to_string(repo_root().join("scenes/default.toml")).unwrap();
+    let cases: &[(&str, &str, &str)] = &[
+        ("radius = 1.0", "radius = 1.0\nweight = 2", "unknown field `weight`"),
+        ("radius = 1.0", "", "missing field `radius`"),
+        ("radius = 1.0", "radius = \"big\"", "invalid type"),
+        ("material = \"red\"", "material = \"crimson\"", "unknown material `crimson`"),
+        ("radius = 1.0", "radius = 0", "greater than 0"),
+        ("radius = 1.0", "radius = -1", "greater than 0"),
+        ("look_at = [0.0, 0.8, 0.0]", "look_at = [0.0, 1.6, -7.0]", "must differ"),
+        ("up = [0.0, 1.0, 0.0]", "up = [0.0, -0.8, 7.0]", "parallel"),
+        ("radius = 1.0", "radius = nan", "finite"),
+        ("intensity = 45", "intensity = inf", "finite"),
+    ];
+    let dir = tempfile::tempdir().unwrap();
+    for (from, to, expected) in cases {
+        assert!(good.contains(from), "{from}");
+        std::fs::write(dir.path().join("bad.toml"), good.replacen(from, to, 1)).unwrap();
+        let out = englobe(dir.path(), &["render", "bad.toml", "-o", "bad.png"]);
+        let err = stderr(&out);
+        assert!(!out.status.success(), "accepted: {to}");
+        let located = err.strip_prefix("error: bad.toml:").unwrap_or_else(|| panic!("{to}: {err}"));
+        let mut parts = located.splitn(3, ':');
+        let line: usize = parts.next().unwrap().parse().unwrap_or_else(|_| panic!("{err}"));
+        let column: usize = parts.next().unwrap().parse().unwrap_or_else(|_| panic!("{err}"));
+        assert!(line > 1 && column >= 1);
+        assert!(err.contains(expected), "{to}: {err}");
+        assert!(!dir.path().join("bad.png").exists());
+        assert!(!err.contains("panicked"));
+    }
+}
+
+#[test]
+fn bad_arguments_and_files_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let refused = |args: &[&str], expected: &str| {
+        let out = englobe(dir.path(), args);
+        assert!(!out.status.success(), "{args:?} was accepted");
+        assert!(stderr(&out).contains(expected), "{args:?}: {}", stderr(&out));
+        assert!(!stderr(&out).contains("panicked"));
+    };
+    refused(&["render", "--width", "0"], "at least 1");
+    refused(&["render", "--width", "100000", "--height", "100000"], "more than the limit");
+    refused(&["render", "--spp", "0"], "samples per pixel");
+    refused(&["render", "--threads", "0"], "--threads");
+    refused(&["render", "missing.toml"], "missing.toml: cannot read");
+    refused(&["render", "."], "is a directory");
+    refused(&["render", "-o", "picture.jpg"], ".png or .exr");
+    refused(&["render", "--accel", "octree"], "unknown accelerator `octree`");
+}
+
+#[test]
+fn a_failed_render_leaves_an_existing_image_untouched() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("keep.png"), b"a good image").unwrap();
+    std::fs::write(dir.path().join("bad.toml"), "[image]\nwidth = 0\nheight = 1\n").unwrap();
+    let out = englobe(dir.path(), &["render", "bad.toml", "-o", "keep.png"]);
+    assert!(!out.status.success());
+    assert_eq!(std::fs::read(dir.path().join("keep.png")).unwrap(), b"a good image");
+}
+
+#[test]
+fn exr_output_is_linear_float() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = englobe(dir.path(), &["render", "--width", "16", "--height", "12", "-o", "hdr.exr"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let img = image::open(dir.path().join("hdr.exr")).unwrap().to_rgb32f();
+    assert_eq!(img.dimensions(), (16, 12));
+}

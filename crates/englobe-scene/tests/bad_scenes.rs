@@ -1,0 +1,175 @@
+//! Every kind of bad scene is refused with an error naming the file, the line and the column of
+//! the offending value, and saying what was expected.
+
+use englobe_scene::{Located, SceneError, parse_scene};
+
+const GOOD: &str = r#"
+[image]
+width = 64
+height = 48
+
+[camera]
+position = [0, 1, -5]
+look_at = [0, 1, 0]
+
+[materials.red]
+diffuse = [0.8, 0.1, 0.1]
+
+[[point_light]]
+position = [2, 4, -3]
+intensity = 10
+
+[[sphere]]
+center = [0, 1, 0]
+radius = 1
+material = "red"
+"#;
+
+/// Parses `text` and returns the located error it must produce.
+fn error_of(text: &str) -> Located {
+    match parse_scene(text, "bad.toml".as_ref()) {
+        Ok(_) => panic!("the scene was accepted:\n{text}"),
+        Err(SceneError::Invalid(l)) => l,
+        Err(e) => panic!("unexpected error kind: {e}"),
+    }
+}
+
+/// The 1-based line and column of byte `offset` of `text`.
+fn line_column(text: &str, offset: usize) -> (usize, usize) {
+    let line = text[..offset].matches('\n').count() + 1;
+    let column = offset - text[..offset].rfind('\n').map_or(0, |i| i + 1) + 1;
+    (line, column)
+}
+
+/// Replaces `from` by `to` in the good scene and expects an error whose message contains
+/// `expected`, located at the first occurrence of `at` inside the replacement, or in the whole
+/// text when `at` is not part of the replacement (a table header, say).
+fn check(from: &str, to: &str, at: &str, expected: &str) {
+    let start = GOOD.find(from).unwrap_or_else(|| panic!("`{from}` not in the good scene"));
+    let text = GOOD.replacen(from, to, 1);
+    let offset = match to.find(at) {
+        Some(i) => start + i,
+        None => text.find(at).unwrap_or_else(|| panic!("`{at}` not in the scene")),
+    };
+    let e = error_of(&text);
+    assert_eq!(e.file, "bad.toml");
+    assert_eq!((e.line, e.column), line_column(&text, offset), "wrong place for {to:?}: {e}");
+    assert!(e.message.contains(expected), "message {:?} does not say {expected:?}", e.message);
+    let shown = e.to_string();
+    assert!(shown.starts_with(&format!("bad.toml:{}:{}: ", e.line, e.column)), "{shown}");
+}
+
+#[test]
+fn the_good_scene_is_accepted() {
+    let s = parse_scene(GOOD, "good.toml".as_ref()).unwrap();
+    assert_eq!((s.image.width, s.image.height, s.objects.len(), s.lights.len()), (64, 48, 1, 1));
+    assert_eq!(s.material_names, ["default", "red"]);
+}
+
+#[test]
+fn unknown_keys() {
+    check("radius = 1", "radius = 1\ncolour = 3", "colour", "unknown field `colour`");
+    check("[image]", "[image]\nwdth = 3", "wdth", "unknown field `wdth`");
+    check("[[sphere]]", "[[sphere]]\nmass = 1", "mass", "unknown field");
+    check("[[sphere]]", "[[spheres]]", "spheres", "unknown field `spheres`");
+}
+
+#[test]
+fn missing_required_keys() {
+    check("radius = 1\n", "", "[[sphere]]", "missing field `radius`");
+    check("width = 64\n", "", "[image]", "missing field `width`");
+    check("look_at = [0, 1, 0]\n", "", "[camera]", "missing field `look_at`");
+    let e = error_of(&GOOD.replacen("[camera]", "[not_camera]", 1));
+    assert!(e.message.contains("unknown field `not_camera`"), "{}", e.message);
+}
+
+#[test]
+fn wrong_types() {
+    check("radius = 1", "radius = \"one\"", "\"one\"", "expected f64");
+    check("width = 64", "width = 64.5", "64.5", "expected u32");
+    check("center = [0, 1, 0]", "center = [0, 1]", "[0, 1]", "expected an array of length 3");
+    check("material = \"red\"", "material = 3", "3\n", "expected a string");
+    check("width = 64", "width = -64", "-64", "expected u32");
+}
+
+#[test]
+fn unknown_material() {
+    check("material = \"red\"", "material = \"blue\"", "\"blue\"", "unknown material `blue`");
+    let e = error_of(&GOOD.replacen("material = \"red\"", "material = \"blue\"", 1));
+    assert!(e.message.contains("default, red"), "lists the known materials: {}", e.message);
+}
+
+#[test]
+fn zero_and_negative_radius() {
+    check("radius = 1", "radius = 0", "0", "greater than 0");
+    check("radius = 1", "radius = -2.5", "-2.5", "greater than 0");
+}
+
+#[test]
+fn degenerate_camera() {
+    check("look_at = [0, 1, 0]", "look_at = [0, 1, -5]", "[0, 1, -5]", "must differ from its position");
+    check("look_at = [0, 1, 0]", "look_at = [0, 1, 0]\nup = [0, 0, 2]", "[0, 0, 2]", "parallel");
+    check("look_at = [0, 1, 0]", "look_at = [0, 1, 0]\nup = [0, 0, 0]", "[0, 0, 0]", "zero or parallel");
+    check("look_at = [0, 1, 0]", "look_at = [0, 1, 0]\nfov = 180", "180", "less than 180");
+    check("look_at = [0, 1, 0]", "fov = 0\nlook_at = [0, 1, 0]", "0", "more than 0");
+}
+
+#[test]
+fn non_finite_numbers() {
+    check("radius = 1", "radius = nan", "nan", "finite");
+    check("radius = 1", "radius = inf", "inf", "finite");
+    // An error inside a vector points at the vector.
+    check("center = [0, 1, 0]", "center = [0, -inf, 0]", "[", "finite");
+    check("intensity = 10", "intensity = nan", "nan", "finite");
+    check("center = [0, 1, 0]", "center = [0, 1e39, 0]", "[", "32-bit float");
+}
+
+#[test]
+fn image_limits() {
+    check("width = 64", "width = 0", "0", "at least 1");
+    check("height = 48", "height = 0", "0", "at least 1");
+    check("width = 64", "width = 10000000", "10000000", "more than the limit");
+    check("width = 64", "width = 64\nsamples = 0", "[image]", "samples per pixel");
+    check("width = 64", "width = 64\nmax_depth = 1000", "[image]", "maximum depth");
+}
+
+#[test]
+fn other_checked_values() {
+    check("[[sphere]]", "[[plane]]\npoint = [0,0,0]\nnormal = [0,0,0]\n[[sphere]]", "[0,0,0]\n[[", "non-zero normal");
+    check("[[sphere]]", "[[box]]\nmin = [0,0,0]\nmax = [1,0,1]\n[[sphere]]", "[[box]]", "min < max");
+    check(
+        "[[sphere]]",
+        "[[triangle]]\nvertices = [[0,0,0],[1,1,1],[2,2,2]]\n[[sphere]]",
+        "[[triangle]]",
+        "area is zero",
+    );
+    check("diffuse = [0.8, 0.1, 0.1]", "diffuse = [0.8, -0.1, 0.1]", "[", "at least 0");
+    check("diffuse = [0.8, 0.1, 0.1]", "reflectivity = 1.5", "1.5", "between 0 and 1");
+    check("diffuse = [0.8, 0.1, 0.1]", "reflectivity = 0.6\ntransparency = 0.6", "[materials.red]", "at most 1");
+    check(
+        "[[sphere]]",
+        "[[sphere_grid]]\norigin = [0,0,0]\nspacing = [1,1,1]\ncounts = [100000, 100000, 1]\nradius = 0.1\n[[sphere]]",
+        "[[sphere_grid]]",
+        "over the limit",
+    );
+}
+
+#[test]
+fn syntax_errors_are_located() {
+    let text = GOOD.replacen("width = 64", "width = = 64", 1);
+    let e = error_of(&text);
+    assert_eq!(e.line, line_column(&text, text.find("width").unwrap()).0);
+}
+
+#[test]
+fn sphere_grid_expands_in_order() {
+    let text = GOOD.replacen(
+        "[[sphere]]",
+        "[[sphere_grid]]\norigin = [0,0,10]\nspacing = [1,2,3]\ncounts = [3,2,1]\nradius = 0.25\n[[sphere]]",
+        1,
+    );
+    let s = parse_scene(&text, "grid.toml".as_ref()).unwrap();
+    assert_eq!(s.objects.len(), 7);
+    let englobe::Object::Shape(englobe::Shape::Sphere(last)) = &s.objects[6].object else { panic!() };
+    assert_eq!(last.center, englobe::Vec3::new(2.0, 2.0, 10.0));
+}
