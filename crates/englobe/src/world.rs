@@ -11,7 +11,7 @@ use std::sync::Arc;
 
 use glam::Vec3;
 
-use crate::accel::{Accel, AccelKind, AnyAccel, Counters, HitRecord, StructureStats};
+use crate::accel::{Accel, AccelKind, AnyAccel, Counters, HitRecord, MAX_PRIMITIVES, StructureStats};
 use crate::shapes::{Bounded, Intersect, PrimHit, Shape, TriangleMesh};
 use crate::{Aabb, Ray};
 
@@ -57,7 +57,7 @@ pub enum WorldError {
         /// Its box.
         bounds: Aabb,
     },
-    /// More primitives than 32-bit indices can name.
+    /// More primitives than a structure can hold ([`MAX_PRIMITIVES`]).
     #[error("too many primitives: {0}")]
     TooManyPrimitives(usize),
 }
@@ -101,7 +101,7 @@ impl World {
                 o => o.primitive_count(),
             })
             .sum();
-        if total >= u32::MAX as usize {
+        if total > MAX_PRIMITIVES {
             return Err(WorldError::TooManyPrimitives(total));
         }
         let mut boxes = Vec::with_capacity(total);

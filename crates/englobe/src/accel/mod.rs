@@ -4,14 +4,21 @@
 //! a query takes a closure that tests primitive `i` exactly. So spheres, triangles, instances and
 //! user shapes all work with every structure, and the work counters of [`counters`] measure every
 //! structure the same way.
+//!
+//! * [`brute`]: no structure; the oracle every other one is checked against.
+//! * [`bvh`]: the canonical binary BVH, its builders and traversals.
+//! * [`validate`]: the invariants of a BVH, checked, and its quality, measured.
 
 pub mod brute;
+pub mod bvh;
 pub mod counters;
+pub mod validate;
 
 use std::fmt;
 use std::str::FromStr;
 
 pub use brute::BruteForce;
+pub use bvh::{Bvh, CandidateListBvh, SeedPairing};
 pub use counters::{Counters, NoCount, WorkCounts};
 
 use crate::shapes::PrimHit;
@@ -106,21 +113,31 @@ impl HitRecord {
     }
 }
 
+/// Most primitives a structure can be built over: node indices are 32-bit, and a binary tree over
+/// `n` primitives has up to `2n - 1` nodes.
+pub const MAX_PRIMITIVES: usize = (1 << 31) - 1;
+
 /// The structures, by name: what `--accel` accepts.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum AccelKind {
     /// Brute force: no structure.
     None,
+    /// The seed report's BVH ([`SeedPairing`]) with the report's traversal ([`CandidateListBvh`]).
+    BvhSeed,
+    /// The seed report's BVH with the ordered traversal of [`Bvh`].
+    BvhSeedOrdered,
 }
 
 impl AccelKind {
     /// Every structure, in the order tables list them.
-    pub const ALL: &'static [AccelKind] = &[AccelKind::None];
+    pub const ALL: &'static [AccelKind] = &[AccelKind::None, AccelKind::BvhSeed, AccelKind::BvhSeedOrdered];
 
     /// The name used on the command line and in tables.
     pub fn name(self) -> &'static str {
         match self {
             AccelKind::None => "none",
+            AccelKind::BvhSeed => "bvh-seed",
+            AccelKind::BvhSeedOrdered => "bvh-seed-ordered",
         }
     }
 
@@ -128,6 +145,12 @@ impl AccelKind {
     pub fn description(self) -> &'static str {
         match self {
             AccelKind::None => "brute force: every ray tests every primitive",
+            AccelKind::BvhSeed => {
+                "the seed report's BVH and traversal: diagonal-key pairing, candidate list, every candidate tested"
+            }
+            AccelKind::BvhSeedOrdered => {
+                "the seed report's BVH, traversed nearer child first with t_max shrinking at each hit"
+            }
         }
     }
 }
@@ -159,13 +182,28 @@ impl FromStr for AccelKind {
 pub enum AnyAccel {
     /// See [`BruteForce`].
     BruteForce(BruteForce),
+    /// See [`AccelKind::BvhSeed`].
+    BvhSeed(CandidateListBvh),
+    /// See [`AccelKind::BvhSeedOrdered`].
+    BvhSeedOrdered(Bvh),
 }
 
 impl AnyAccel {
-    /// Builds the structure `kind` over the primitives' boxes.
+    /// Builds the structure `kind` over the primitives' boxes (at most [`MAX_PRIMITIVES`]).
     pub fn build(kind: AccelKind, boxes: &[Aabb]) -> Self {
         match kind {
             AccelKind::None => AnyAccel::BruteForce(BruteForce::build(boxes)),
+            AccelKind::BvhSeed => AnyAccel::BvhSeed(CandidateListBvh::build(boxes)),
+            AccelKind::BvhSeedOrdered => AnyAccel::BvhSeedOrdered(SeedPairing::build(boxes)),
+        }
+    }
+
+    /// The BVH behind the structure, if it is one (for validation and statistics).
+    pub fn bvh(&self) -> Option<&Bvh> {
+        match self {
+            AnyAccel::BruteForce(_) => None,
+            AnyAccel::BvhSeed(a) => Some(a.bvh()),
+            AnyAccel::BvhSeedOrdered(a) => Some(a),
         }
     }
 }
@@ -174,6 +212,8 @@ macro_rules! dispatch_accel {
     ($self:ident, $a:ident => $e:expr) => {
         match $self {
             AnyAccel::BruteForce($a) => $e,
+            AnyAccel::BvhSeed($a) => $e,
+            AnyAccel::BvhSeedOrdered($a) => $e,
         }
     };
 }

@@ -1,0 +1,154 @@
+//! From a builder's tree to the flat layout of [`Bvh`].
+//!
+//! Builders work on whatever tree suits them (bottom-up pairing, top-down splits) and hand over a
+//! [`BuildTree`]: an arena of nodes, each a leaf over a range of the builder's primitive order or
+//! an interior node with two children. [`BuildTree::into_bvh`] lays it out depth-first with the
+//! first child right after its parent, as pbrt's `flattenBVH` does (Pharr, Jakob and Humphreys,
+//! "Physically Based Rendering", 3rd ed. 2016, section 4.3.4), and records the depth. The walk uses
+//! an explicit stack, so a degenerate tree (a chain as deep as it has primitives) is laid out
+//! without exhausting the call stack.
+
+use super::{Bvh, BvhNode};
+use crate::Aabb;
+
+/// What a node of a [`BuildTree`] is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BuildKind {
+    /// A leaf over `prims[first..first + count]` of its tree (`count >= 1`).
+    Leaf {
+        /// First entry in [`BuildTree::prims`].
+        first: u32,
+        /// Number of entries.
+        count: u32,
+    },
+    /// An interior node; the children are indices into [`BuildTree::nodes`].
+    Interior {
+        /// The first and second child.
+        children: [u32; 2],
+    },
+}
+
+/// A node of a [`BuildTree`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BuildNode {
+    /// The node's box.
+    pub bounds: Aabb,
+    /// Leaf or interior node.
+    pub kind: BuildKind,
+}
+
+/// A binary tree as a builder makes it, before layout: nodes in any order, a root, and the
+/// primitive references its leaves point into.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct BuildTree {
+    /// Every node, in the builder's order.
+    pub nodes: Vec<BuildNode>,
+    /// Primitive indices; leaves hold ranges of this list.
+    pub prims: Vec<u32>,
+    /// Index of the root in `nodes` (ignored when `nodes` is empty).
+    pub root: u32,
+}
+
+impl BuildTree {
+    /// Lays the tree out depth-first: each interior node is followed by its first child's subtree,
+    /// then its second child's; leaves' references are copied in the same order.
+    ///
+    /// The tree is trusted to be a tree (every node reachable once from the root); builders
+    /// guarantee it and the validator checks the result.
+    pub fn into_bvh(self) -> Bvh {
+        if self.nodes.is_empty() {
+            return Bvh::empty();
+        }
+        let mut nodes = Vec::with_capacity(self.nodes.len());
+        let mut prim_indices = Vec::with_capacity(self.prims.len());
+        let mut depth = 0u32;
+        // (build node, flat node whose second-child index must point here, depth of the node)
+        let mut stack: Vec<(u32, Option<usize>, u32)> = vec![(self.root, None, 0)];
+        while let Some((id, patch, level)) = stack.pop() {
+            let here = nodes.len();
+            if let Some(parent) = patch {
+                let parent: &mut BvhNode = &mut nodes[parent];
+                parent.index = here as u32;
+            }
+            depth = depth.max(level);
+            let node = &self.nodes[id as usize];
+            match node.kind {
+                BuildKind::Leaf { first, count } => {
+                    let range = first as usize..first as usize + count as usize;
+                    nodes.push(BvhNode::leaf(node.bounds, prim_indices.len() as u32, count));
+                    prim_indices.extend_from_slice(&self.prims[range]);
+                }
+                BuildKind::Interior { children: [first, second] } => {
+                    // The second child's index is patched in when it is laid out.
+                    nodes.push(BvhNode::interior(node.bounds, 0));
+                    stack.push((second, Some(here), level + 1));
+                    stack.push((first, None, level + 1));
+                }
+            }
+        }
+        Bvh::from_parts(nodes, prim_indices, depth)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::Vec3;
+
+    use super::*;
+
+    fn unit_at(x: f32) -> Aabb {
+        Aabb::new(Vec3::new(x, 0.0, 0.0), Vec3::new(x + 1.0, 1.0, 1.0))
+    }
+
+    #[test]
+    fn lays_out_depth_first_with_the_first_child_next() {
+        // root(4) = [n3 = [leaf0, leaf1], leaf2], built bottom-up (root last).
+        let tree = BuildTree {
+            nodes: vec![
+                BuildNode { bounds: unit_at(0.0), kind: BuildKind::Leaf { first: 0, count: 1 } },
+                BuildNode { bounds: unit_at(1.0), kind: BuildKind::Leaf { first: 1, count: 1 } },
+                BuildNode { bounds: unit_at(2.0), kind: BuildKind::Leaf { first: 2, count: 2 } },
+                BuildNode { bounds: unit_at(0.0).union(&unit_at(1.0)), kind: BuildKind::Interior { children: [0, 1] } },
+                BuildNode { bounds: unit_at(0.0).union(&unit_at(2.0)), kind: BuildKind::Interior { children: [3, 2] } },
+            ],
+            prims: vec![7, 5, 6, 4],
+            root: 4,
+        };
+        let bvh = tree.into_bvh();
+        let n = bvh.nodes();
+        assert_eq!(n.len(), 5);
+        assert_eq!(bvh.depth(), 2);
+        assert!(!n[0].is_leaf() && n[0].index == 4, "root's second child is the last leaf");
+        assert!(!n[1].is_leaf() && n[1].index == 3);
+        assert_eq!((n[2].index, n[2].count), (0, 1));
+        assert_eq!((n[3].index, n[3].count), (1, 1));
+        assert_eq!((n[4].index, n[4].count), (2, 2));
+        assert_eq!(bvh.prim_indices(), &[7, 5, 6, 4]);
+    }
+
+    #[test]
+    fn a_deep_chain_is_laid_out_without_recursion() {
+        // A chain 100 000 deep: interior i has children (leaf i, interior i + 1).
+        let n = 100_000u32;
+        let mut nodes = Vec::new();
+        for i in 0..n {
+            nodes.push(BuildNode { bounds: unit_at(0.0), kind: BuildKind::Leaf { first: i, count: 1 } });
+        }
+        for i in 0..n - 1 {
+            let next = if i + 1 == n - 1 { n - 1 } else { n + i + 1 };
+            nodes.push(BuildNode { bounds: unit_at(0.0), kind: BuildKind::Interior { children: [next, i] } });
+        }
+        let tree = BuildTree { nodes, prims: (0..n).collect(), root: n };
+        let bvh = tree.into_bvh();
+        assert_eq!(bvh.nodes().len(), 2 * n as usize - 1);
+        assert_eq!(bvh.depth(), n - 1);
+    }
+
+    #[test]
+    fn empty_tree_has_no_node() {
+        let bvh = BuildTree::default().into_bvh();
+        assert!(bvh.nodes().is_empty() && bvh.prim_indices().is_empty());
+        assert_eq!(bvh.depth(), 0);
+        assert!(bvh.bounds().is_empty());
+    }
+}

@@ -1,0 +1,148 @@
+//! The canonical binary bounding volume hierarchy (BVH) that every BVH builder produces, and the
+//! traversals that query it.
+//!
+//! The layout is the flat depth-first one of pbrt (Pharr, Jakob and Humphreys, "Physically Based
+//! Rendering", 3rd ed. 2016, section 4.3.4, `LinearBVHNode`): 32-byte nodes in one array, the first
+//! child of an interior node stored right after it, the node itself holding the index of its second
+//! child; a leaf holds a range of `prim_indices`. The tree records its depth so that traversals can
+//! size their stack once, without allocating per ray.
+//!
+//! * [`layout`]: a builder's tree ([`BuildTree`]) laid out into a [`Bvh`].
+//! * [`seed_pairing`]: the seed report's builder ([`SeedPairing`]).
+//! * [`ordered`]: nearer child first, `t_max` shrinking at each hit (what `Bvh` answers queries with).
+//! * [`candidates`]: the seed report's own traversal ([`CandidateListBvh`]).
+//! * [`stats`]: node count, leaves, depth, memory and SAH cost.
+
+pub mod candidates;
+pub mod layout;
+pub mod ordered;
+pub mod seed_pairing;
+pub mod stats;
+
+use std::ops::Range;
+
+use glam::Vec3;
+
+pub use candidates::CandidateListBvh;
+pub use layout::{BuildKind, BuildNode, BuildTree};
+pub use seed_pairing::SeedPairing;
+pub use stats::{SAH_INTERSECTION_COST, SAH_TRAVERSAL_COST};
+
+use super::{Accel, Counters, Hit, StructureStats};
+use crate::shapes::PrimHit;
+use crate::{Aabb, Ray};
+
+/// One node of a [`Bvh`]: its box, and either its second child (interior node; the first child is
+/// the next node of the array) or its range of primitive references (leaf). 32 bytes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C)]
+pub struct BvhNode {
+    /// Lower corner of the node's box.
+    pub min: [f32; 3],
+    /// Interior node: index of the second child. Leaf: offset of its first entry in
+    /// [`Bvh::prim_indices`].
+    pub index: u32,
+    /// Upper corner of the node's box.
+    pub max: [f32; 3],
+    /// Number of primitives of a leaf; 0 for an interior node.
+    pub count: u32,
+}
+
+const _: () = assert!(std::mem::size_of::<BvhNode>() == 32);
+
+impl BvhNode {
+    /// An interior node whose second child is `second_child`.
+    pub fn interior(bounds: Aabb, second_child: u32) -> Self {
+        BvhNode { min: bounds.min.to_array(), index: second_child, max: bounds.max.to_array(), count: 0 }
+    }
+
+    /// A leaf holding `count >= 1` references starting at `first`.
+    pub fn leaf(bounds: Aabb, first: u32, count: u32) -> Self {
+        BvhNode { min: bounds.min.to_array(), index: first, max: bounds.max.to_array(), count }
+    }
+
+    /// The node's box.
+    #[inline(always)]
+    pub fn bounds(&self) -> Aabb {
+        Aabb::new(Vec3::from_array(self.min), Vec3::from_array(self.max))
+    }
+
+    /// True for a leaf.
+    #[inline(always)]
+    pub fn is_leaf(&self) -> bool {
+        self.count > 0
+    }
+
+    /// A leaf's range in [`Bvh::prim_indices`] (empty for interior nodes).
+    #[inline(always)]
+    pub fn prim_range(&self) -> Range<usize> {
+        if self.count == 0 { 0..0 } else { self.index as usize..self.index as usize + self.count as usize }
+    }
+}
+
+/// A binary BVH in the flat depth-first layout. Built by a builder ([`SeedPairing`], ...) from the
+/// primitives' boxes; queried with the ordered traversal (see [`ordered`]).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Bvh {
+    nodes: Vec<BvhNode>,
+    prim_indices: Vec<u32>,
+    depth: u32,
+}
+
+impl Bvh {
+    /// The tree over no primitive: no node at all; every query misses.
+    pub fn empty() -> Self {
+        Bvh::default()
+    }
+
+    /// A tree from its parts, unchecked: [`crate::accel::validate::validate_bvh`] says whether it
+    /// is well formed. Queries on a malformed tree give wrong answers or panic, never worse.
+    pub(crate) fn from_parts(nodes: Vec<BvhNode>, prim_indices: Vec<u32>, depth: u32) -> Self {
+        Bvh { nodes, prim_indices, depth }
+    }
+
+    /// The nodes; the root is node 0.
+    pub fn nodes(&self) -> &[BvhNode] {
+        &self.nodes
+    }
+
+    /// The primitive references of all leaves, leaf after leaf.
+    pub fn prim_indices(&self) -> &[u32] {
+        &self.prim_indices
+    }
+
+    /// Edges on the longest path from the root to a leaf (0 for a single leaf or no node).
+    pub fn depth(&self) -> u32 {
+        self.depth
+    }
+
+    /// The root's box (the empty box for an empty tree).
+    pub fn bounds(&self) -> Aabb {
+        self.nodes.first().map_or(Aabb::EMPTY, BvhNode::bounds)
+    }
+}
+
+impl Accel for Bvh {
+    fn bounds(&self) -> Aabb {
+        Bvh::bounds(self)
+    }
+
+    #[inline]
+    fn closest_hit<C: Counters>(
+        &self,
+        ray: &Ray,
+        counters: &mut C,
+        intersect: impl FnMut(u32, &Ray) -> Option<PrimHit>,
+    ) -> Option<Hit> {
+        self.closest_hit_ordered(ray, counters, intersect)
+    }
+
+    #[inline]
+    fn any_hit<C: Counters>(&self, ray: &Ray, counters: &mut C, occludes: impl FnMut(u32, &Ray) -> bool) -> bool {
+        self.any_hit_ordered(ray, counters, occludes)
+    }
+
+    fn stats(&self) -> StructureStats {
+        self.structure_stats()
+    }
+}

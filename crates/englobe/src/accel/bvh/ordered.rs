@@ -1,0 +1,266 @@
+//! The ordered traversal of a [`Bvh`]: iterative, nearer child first, with the ray's `t_max`
+//! shrinking at each hit so that boxes entirely behind the closest hit found so far are skipped;
+//! occlusion queries stop at the first occluder.
+//!
+//! This is the classic front-to-back traversal of Kay and Kajiya (1986), "Ray Tracing Complex
+//! Scenes" (SIGGRAPH), in the stack-based form of pbrt (Pharr, Jakob and Humphreys, "Physically
+//! Based Rendering", 3rd ed. 2016, section 4.3.5). Both children's boxes are tested when a node is
+//! entered; the nearer one (by entry distance) is entered next and the farther one is pushed with
+//! its entry distance, so that it is dropped without another box test if a closer hit has been
+//! found by the time it is popped.
+//!
+//! The stack holds at most one entry per level of the path from the root, so the tree's recorded
+//! depth bounds it: trees up to [`INLINE_STACK`] deep use a fixed array on the call stack; deeper
+//! ones (only degenerate builds are) use one heap buffer for the query, never one per node.
+
+use super::Bvh;
+use crate::Ray;
+use crate::accel::{Counters, Hit, HitRecord};
+use crate::shapes::PrimHit;
+
+/// Depth up to which the traversal stack lives in a fixed array (a balanced tree this deep holds
+/// 2^64 leaves).
+pub const INLINE_STACK: usize = 64;
+
+/// A pending subtree: its node and the distance at which the ray enters its box.
+type Pending = (u32, f32);
+
+impl Bvh {
+    /// Runs `query` with a traversal stack large enough for this tree.
+    #[inline(always)]
+    fn with_stack<R>(&self, query: impl FnOnce(&mut [Pending]) -> R) -> R {
+        let needed = self.depth as usize;
+        if needed <= INLINE_STACK {
+            let mut inline = [(0u32, 0f32); INLINE_STACK];
+            query(&mut inline)
+        } else {
+            query(&mut vec![(0u32, 0f32); needed])
+        }
+    }
+
+    /// The closest hit (see [`crate::accel::Accel::closest_hit`]), nearer child first.
+    #[inline]
+    pub fn closest_hit_ordered<C: Counters>(
+        &self,
+        ray: &Ray,
+        counters: &mut C,
+        mut intersect: impl FnMut(u32, &Ray) -> Option<PrimHit>,
+    ) -> Option<Hit> {
+        if !ray.is_valid() || self.nodes.is_empty() {
+            return None;
+        }
+        let mut record = HitRecord::new(*ray);
+        counters.box_tests(1);
+        self.nodes[0].bounds().intersect(&record.ray)?;
+        self.with_stack(|stack| {
+            let mut len = 0usize;
+            let mut current = 0usize;
+            loop {
+                let node = &self.nodes[current];
+                counters.node_visited();
+                if node.is_leaf() {
+                    for &prim in &self.prim_indices[node.prim_range()] {
+                        counters.exact_test();
+                        if let Some(hit) = intersect(prim, &record.ray) {
+                            record.offer(prim, hit);
+                        }
+                    }
+                } else {
+                    let (first, second) = (current + 1, node.index as usize);
+                    counters.box_tests(2);
+                    let t_first = self.nodes[first].bounds().intersect(&record.ray).map(|(t, _)| t);
+                    let t_second = self.nodes[second].bounds().intersect(&record.ray).map(|(t, _)| t);
+                    match (t_first, t_second) {
+                        (Some(a), Some(b)) => {
+                            // Equal entry distances keep the first child first.
+                            let (near, far, t_far) = if b < a { (second, first, a) } else { (first, second, b) };
+                            stack[len] = (far as u32, t_far);
+                            len += 1;
+                            current = near;
+                            continue;
+                        }
+                        (Some(_), None) => {
+                            current = first;
+                            continue;
+                        }
+                        (None, Some(_)) => {
+                            current = second;
+                            continue;
+                        }
+                        (None, None) => {}
+                    }
+                }
+                // Next pending subtree that the ray still enters before the closest hit. Entry at
+                // exactly `t_max` is kept: a primitive there may win the tie by index.
+                loop {
+                    if len == 0 {
+                        return record.hit;
+                    }
+                    len -= 1;
+                    let (node, t_enter) = stack[len];
+                    if t_enter <= record.ray.t_max {
+                        current = node as usize;
+                        break;
+                    }
+                }
+            }
+        })
+    }
+
+    /// Whether any primitive occludes the ray (see [`crate::accel::Accel::any_hit`]); stops at
+    /// the first occluder. Children are still entered nearer first, which tends to find an
+    /// occluder sooner.
+    #[inline]
+    pub fn any_hit_ordered<C: Counters>(
+        &self,
+        ray: &Ray,
+        counters: &mut C,
+        mut occludes: impl FnMut(u32, &Ray) -> bool,
+    ) -> bool {
+        if !ray.is_valid() || self.nodes.is_empty() {
+            return false;
+        }
+        counters.box_tests(1);
+        if self.nodes[0].bounds().intersect(ray).is_none() {
+            return false;
+        }
+        self.with_stack(|stack| {
+            let mut len = 0usize;
+            let mut current = 0usize;
+            loop {
+                let node = &self.nodes[current];
+                counters.node_visited();
+                if node.is_leaf() {
+                    for &prim in &self.prim_indices[node.prim_range()] {
+                        counters.exact_test();
+                        if occludes(prim, ray) {
+                            return true;
+                        }
+                    }
+                } else {
+                    let (first, second) = (current + 1, node.index as usize);
+                    counters.box_tests(2);
+                    let t_first = self.nodes[first].bounds().intersect(ray).map(|(t, _)| t);
+                    let t_second = self.nodes[second].bounds().intersect(ray).map(|(t, _)| t);
+                    match (t_first, t_second) {
+                        (Some(a), Some(b)) => {
+                            let (near, far) = if b < a { (second, first) } else { (first, second) };
+                            stack[len] = (far as u32, 0.0);
+                            len += 1;
+                            current = near;
+                            continue;
+                        }
+                        (Some(_), None) => {
+                            current = first;
+                            continue;
+                        }
+                        (None, Some(_)) => {
+                            current = second;
+                            continue;
+                        }
+                        (None, None) => {}
+                    }
+                }
+                if len == 0 {
+                    return false;
+                }
+                len -= 1;
+                current = stack[len].0 as usize;
+            }
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::Vec3;
+
+    use super::*;
+    use crate::Aabb;
+    use crate::accel::WorkCounts;
+    use crate::accel::bvh::{BuildKind, BuildNode, BuildTree, SeedPairing};
+    use crate::shapes::{Intersect, Sphere};
+
+    fn row(n: usize) -> Vec<Sphere> {
+        (0..n).map(|i| Sphere::new(Vec3::new(0.0, 0.0, 2.0 + 3.0 * i as f32), 1.0)).collect()
+    }
+
+    fn boxes(spheres: &[Sphere]) -> Vec<Aabb> {
+        use crate::shapes::Bounded;
+        spheres.iter().map(Bounded::bounds).collect()
+    }
+
+    #[test]
+    fn boxes_behind_the_closest_hit_are_skipped() {
+        let spheres = row(64);
+        let bvh = SeedPairing::build(&boxes(&spheres));
+        let mut c = WorkCounts::default();
+        let hit = bvh
+            .closest_hit_ordered(&Ray::new(Vec3::ZERO, Vec3::Z), &mut c, |i, r| spheres[i as usize].intersect(r))
+            .unwrap();
+        assert_eq!((hit.prim, hit.t), (0, 1.0));
+        assert_eq!(c.exact_tests, 1, "only the nearest sphere is tested");
+        assert_eq!(c.nodes_visited, bvh.depth() as u64 + 1, "one path from the root to the nearest leaf");
+        // From the far end, looking back: the nearest is the last sphere.
+        let back = Ray::new(Vec3::new(0.0, 0.0, 300.0), -Vec3::Z);
+        let hit = bvh.closest_hit_ordered(&back, &mut c, |i, r| spheres[i as usize].intersect(r)).unwrap();
+        assert_eq!(hit.prim, 63);
+    }
+
+    #[test]
+    fn any_hit_stops_at_the_first_occluder() {
+        let spheres = row(64);
+        let bvh = SeedPairing::build(&boxes(&spheres));
+        let mut c = WorkCounts::default();
+        assert!(bvh.any_hit_ordered(&Ray::new(Vec3::ZERO, Vec3::Z), &mut c, |i, r| {
+            spheres[i as usize].intersect(r).is_some()
+        }));
+        assert_eq!(c.exact_tests, 1);
+        let short = Ray::segment(Vec3::ZERO, Vec3::Z, 0.0, 0.5);
+        assert!(!bvh.any_hit_ordered(&short, &mut c, |i, r| spheres[i as usize].intersect(r).is_some()));
+    }
+
+    #[test]
+    fn a_degenerate_chain_deeper_than_the_inline_stack_is_traversed() {
+        // A chain 200 deep whose deepest leaf is the only one the ray hits: every level pushes.
+        let n = 200u32;
+        let hit_box = Aabb::new(Vec3::new(-1.0, -1.0, 9.0), Vec3::new(1.0, 1.0, 10.0));
+        let mut nodes = Vec::new();
+        for i in 0..n {
+            // Leaf i's box lies on the ray beyond the last leaf's, so the chain is always the
+            // nearer child and every leaf is pushed; only the last leaf's primitive is hit.
+            let b = if i == n - 1 {
+                hit_box
+            } else {
+                Aabb::new(Vec3::new(-1.0, -1.0, 20.0 + i as f32), Vec3::new(1.0, 1.0, 21.0 + i as f32))
+            };
+            nodes.push(BuildNode { bounds: b, kind: BuildKind::Leaf { first: i, count: 1 } });
+        }
+        let all = nodes.iter().fold(Aabb::EMPTY, |a, b| a.union(&b.bounds));
+        for i in 0..n - 1 {
+            let next = if i + 1 == n - 1 { n - 1 } else { n + i + 1 };
+            nodes.push(BuildNode { bounds: all, kind: BuildKind::Interior { children: [i, next] } });
+        }
+        let bvh = BuildTree { nodes, prims: (0..n).collect(), root: n }.into_bvh();
+        assert!(bvh.depth() as usize > INLINE_STACK);
+        let mut c = WorkCounts::default();
+        let hit = bvh.closest_hit_ordered(&Ray::new(Vec3::ZERO, Vec3::Z), &mut c, |i, r| {
+            if i == n - 1 { hit_box.intersect(r).map(|(t, _)| PrimHit::at(t)) } else { None }
+        });
+        assert_eq!(hit.map(|h| h.prim), Some(n - 1));
+        assert!(bvh.any_hit_ordered(&Ray::new(Vec3::ZERO, Vec3::Z), &mut c, |i, _| i == n - 1));
+    }
+
+    #[test]
+    fn invalid_rays_and_empty_trees_visit_nothing() {
+        let mut c = WorkCounts::default();
+        let spheres = row(3);
+        let bvh = SeedPairing::build(&boxes(&spheres));
+        let bad = Ray::new(Vec3::ZERO, Vec3::ZERO);
+        assert!(bvh.closest_hit_ordered(&bad, &mut c, |_, _| Some(PrimHit::at(1.0))).is_none());
+        assert!(!bvh.any_hit_ordered(&bad, &mut c, |_, _| true));
+        let empty = Bvh::empty();
+        assert!(empty.closest_hit_ordered(&Ray::new(Vec3::ZERO, Vec3::Z), &mut c, |_, _| None).is_none());
+        assert_eq!(c, WorkCounts::default());
+    }
+}
