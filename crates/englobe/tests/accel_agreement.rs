@@ -1,0 +1,219 @@
+//! Every structure of `AccelKind::ALL` against brute force: the same closest hit (primitive and
+//! `t`) and the same any-hit answer, on random scenes of spheres and triangles and random rays
+//! (axis-parallel ones, rays from inside primitives, rays aimed at primitives, short segments),
+//! and on degenerate inputs. Structures added later are checked here without a line changed.
+
+mod common;
+
+use common::check_all_structures;
+use englobe::{Aabb, Bounded, Intersect, PrimHit, Ray, Shape, Sphere, Triangle, Vec3};
+use proptest::prelude::*;
+
+/// Coordinates: mostly arbitrary, sometimes integers, so that shared edges, equal distances and
+/// rays lying in box faces happen.
+fn coord() -> impl Strategy<Value = f32> {
+    prop_oneof![3 => -10.0f32..10.0, 1 => (-6i32..=6).prop_map(|i| i as f32)]
+}
+
+fn point() -> impl Strategy<Value = Vec3> {
+    (coord(), coord(), coord()).prop_map(|(x, y, z)| Vec3::new(x, y, z))
+}
+
+fn shape() -> impl Strategy<Value = Shape> {
+    prop_oneof![
+        (point(), prop_oneof![0.05f32..3.0, (1u8..=3).prop_map(f32::from)])
+            .prop_map(|(c, r)| Shape::from(Sphere::new(c, r))),
+        // Triangles near a random point, so that they stay small enough to be missed.
+        (point(), point(), point()).prop_map(|(a, b, c)| Shape::from(Triangle::new(
+            a,
+            a + (b - a) * 0.3,
+            a + (c - a) * 0.3
+        ))),
+    ]
+}
+
+/// Directions: random, axis-parallel (of both signs, with zeros of both signs), or in a plane.
+fn direction() -> impl Strategy<Value = Vec3> {
+    let axis = (0usize..3, prop::bool::ANY, prop::bool::ANY).prop_map(|(axis, negative, negative_zeros)| {
+        let zero = if negative_zeros { -0.0 } else { 0.0 };
+        let mut d = Vec3::splat(zero);
+        d[axis] = if negative { -1.0 } else { 1.0 };
+        d
+    });
+    let planar = (0usize..3, -1.0f32..1.0, -1.0f32..1.0).prop_map(|(axis, a, b)| {
+        let mut d = Vec3::new(a, b, 1.0 - a.abs());
+        d[axis] = 0.0;
+        d
+    });
+    prop_oneof![4 => point(), 2 => axis, 1 => planar].prop_filter("a direction", |d| *d != Vec3::ZERO)
+}
+
+/// How a ray starts: anywhere, at a primitive's centre (inside it, or on a triangle), or aimed at
+/// a primitive's centre from anywhere.
+#[derive(Clone, Debug)]
+enum Start {
+    Free(Vec3, Vec3),
+    FromCentre(usize, Vec3),
+    AtCentre(usize, Vec3),
+}
+
+fn ray_spec() -> impl Strategy<Value = (Start, f32, f32)> {
+    let start = prop_oneof![
+        2 => (point().prop_map(|p| p * 1.5), direction()).prop_map(|(o, d)| Start::Free(o, d)),
+        1 => (any::<prop::sample::Index>(), direction()).prop_map(|(i, d)| Start::FromCentre(i.index(usize::MAX), d)),
+        2 => (any::<prop::sample::Index>(), point().prop_map(|p| p * 1.5)).prop_map(|(i, o)| Start::AtCentre(i.index(usize::MAX), o)),
+    ];
+    let range = prop_oneof![
+        4 => Just((0.0f32, f32::INFINITY)),
+        1 => (0.0f32..5.0, 0.0f32..20.0).prop_map(|(a, b)| (a, a + b)),
+    ];
+    (start, range).prop_map(|(s, (t0, t1))| (s, t0, t1))
+}
+
+fn make_ray(shapes: &[Shape], (start, t_min, t_max): &(Start, f32, f32)) -> Ray {
+    let centre = |i: usize| shapes[i % shapes.len().max(1)].bounds().center();
+    let (origin, dir) = match *start {
+        Start::Free(o, d) => (o, d),
+        Start::FromCentre(i, d) if !shapes.is_empty() => (centre(i), d),
+        Start::AtCentre(i, o) if !shapes.is_empty() && centre(i) != o => (o, centre(i) - o),
+        Start::FromCentre(_, d) => (Vec3::ZERO, d),
+        Start::AtCentre(_, o) => (o, Vec3::Z),
+    };
+    Ray::segment(origin, dir, *t_min, *t_max)
+}
+
+fn check(shapes: &[Shape], rays: &[Ray]) -> Result<(), TestCaseError> {
+    let boxes: Vec<Aabb> = shapes.iter().map(Bounded::bounds).collect();
+    check_all_structures(&boxes, rays, |i, r| shapes[i as usize].intersect(r)).map_err(TestCaseError::fail)
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 192, ..ProptestConfig::default() })]
+
+    #[test]
+    fn random_spheres_and_triangles(
+        shapes in prop::collection::vec(shape(), 0..48),
+        specs in prop::collection::vec(ray_spec(), 1..48),
+    ) {
+        let rays: Vec<Ray> = specs.iter().map(|s| make_ray(&shapes, s)).collect();
+        check(&shapes, &rays)?;
+    }
+
+    #[test]
+    fn many_primitives_few_rays(
+        shapes in prop::collection::vec(shape(), 100..400),
+        specs in prop::collection::vec(ray_spec(), 1..16),
+    ) {
+        let rays: Vec<Ray> = specs.iter().map(|s| make_ray(&shapes, s)).collect();
+        check(&shapes, &rays)?;
+    }
+
+    #[test]
+    fn copies_of_one_primitive_tie_to_the_lowest_index(
+        original in shape(),
+        copies in 1usize..40,
+        specs in prop::collection::vec(ray_spec(), 1..24),
+    ) {
+        let shapes = vec![original; copies];
+        let rays: Vec<Ray> = specs.iter().map(|s| make_ray(&shapes, s)).collect();
+        check(&shapes, &rays)?;
+    }
+}
+
+/// Rays through the origin along every axis and diagonal, from both sides.
+fn star_rays() -> Vec<Ray> {
+    let mut rays = Vec::new();
+    for x in -1i32..=1 {
+        for y in -1i32..=1 {
+            for z in -1i32..=1 {
+                let d = Vec3::new(x as f32, y as f32, z as f32);
+                if d != Vec3::ZERO {
+                    rays.push(Ray::new(-d * 20.0, d));
+                    rays.push(Ray::new(Vec3::ZERO, d));
+                    rays.push(Ray::new(Vec3::new(0.5, 0.25, 0.0) - d * 20.0, d));
+                }
+            }
+        }
+    }
+    rays
+}
+
+#[test]
+fn no_primitive_at_all() {
+    check(&[], &star_rays()).unwrap();
+}
+
+#[test]
+fn a_single_primitive() {
+    check(&[Sphere::new(Vec3::ZERO, 1.0).into()], &star_rays()).unwrap();
+    check(&[Triangle::new(Vec3::new(-1.0, -1.0, 0.0), Vec3::new(1.0, -1.0, 0.0), Vec3::Y).into()], &star_rays())
+        .unwrap();
+}
+
+#[test]
+fn identical_boxes() {
+    // 64 copies of one sphere: every query ties, and the lowest index must win everywhere.
+    let shapes = vec![Shape::from(Sphere::new(Vec3::ZERO, 1.0)); 64];
+    check(&shapes, &star_rays()).unwrap();
+    let boxes: Vec<Aabb> = shapes.iter().map(Bounded::bounds).collect();
+    let hit = englobe::AnyAccel::build(englobe::AccelKind::BvhSeedOrdered, &boxes).bvh().map(|b| b.depth()).unwrap();
+    assert_eq!(hit, 6);
+}
+
+#[test]
+fn a_flat_grid_of_triangles_with_shared_edges() {
+    // Two triangles per unit square on z = 0: rays along the grid lines and through vertices
+    // must find exactly the triangle brute force finds.
+    let mut shapes = Vec::new();
+    for i in -4..4 {
+        for j in -4..4 {
+            let p = |a: i32, b: i32| Vec3::new(a as f32, b as f32, 0.0);
+            shapes.push(Shape::from(Triangle::new(p(i, j), p(i + 1, j), p(i + 1, j + 1))));
+            shapes.push(Shape::from(Triangle::new(p(i, j), p(i + 1, j + 1), p(i, j + 1))));
+        }
+    }
+    let mut rays = star_rays();
+    for a in -5..=5 {
+        for b in -5..=5 {
+            rays.push(Ray::new(Vec3::new(a as f32, b as f32, 3.0), -Vec3::Z));
+            rays.push(Ray::new(Vec3::new(a as f32 * 0.5, b as f32 * 0.5, -3.0), Vec3::new(0.1, 0.0, 1.0)));
+            // In the plane of the grid, along a grid line.
+            rays.push(Ray::new(Vec3::new(a as f32, -10.0, 0.0), Vec3::Y));
+        }
+    }
+    check(&shapes, &rays).unwrap();
+}
+
+#[test]
+fn invalid_rays_hit_nothing_anywhere() {
+    let shapes = vec![Shape::from(Sphere::new(Vec3::ZERO, 1.0)); 3];
+    let rays = [
+        Ray::new(Vec3::ZERO, Vec3::ZERO),
+        Ray::new(Vec3::new(f32::NAN, 0.0, 0.0), Vec3::X),
+        Ray::segment(Vec3::new(0.0, 0.0, -5.0), Vec3::Z, 3.0, 2.0),
+    ];
+    check(&shapes, &rays).unwrap();
+    let boxes: Vec<Aabb> = shapes.iter().map(Bounded::bounds).collect();
+    for &kind in englobe::AccelKind::ALL {
+        let accel = englobe::AnyAccel::build(kind, &boxes);
+        for r in &rays {
+            let mut c = englobe::WorkCounts::default();
+            assert!(englobe::Accel::closest_hit(&accel, r, &mut c, |_, _| Some(PrimHit::at(0.0))).is_none());
+            assert_eq!(c, englobe::WorkCounts::default(), "{kind} visited something for {r:?}");
+        }
+    }
+}
+
+#[test]
+fn a_tie_in_a_subtree_entered_exactly_at_the_hit() {
+    // Primitive 1 (a sphere) is hit at t = 5 first; primitive 0 (a triangle whose box the ray
+    // enters at exactly t = 5) is hit at the same t and must win the tie by its lower index.
+    let shapes = vec![
+        Shape::from(Triangle::new(Vec3::new(-1.0, -1.0, 5.0), Vec3::new(5.0, -1.0, 5.0), Vec3::new(-1.0, 5.0, 5.0))),
+        Shape::from(Sphere::new(Vec3::new(0.0, 0.0, 6.0), 1.0)),
+    ];
+    let ray = Ray::new(Vec3::ZERO, Vec3::Z);
+    assert_eq!(shapes[0].intersect(&ray).map(|h| h.t), Some(5.0));
+    assert_eq!(shapes[1].intersect(&ray).map(|h| h.t), Some(5.0));
+    check(&shapes, &[ray]).unwrap();
+}

@@ -1,0 +1,85 @@
+//! Shared by the cross-structure tests: one check that runs every structure of
+//! [`AccelKind::ALL`] against brute force, and the shared data folder.
+
+#![allow(dead_code)]
+
+use std::path::PathBuf;
+
+use englobe::accel::validate::validate_bvh;
+use englobe::{Aabb, Accel, AccelKind, AnyAccel, Hit, NoCount, PrimHit, Ray, WorkCounts};
+
+/// Relative tolerance on the closest hit's `t`.
+pub const T_TOLERANCE: f32 = 1e-6;
+
+/// Builds every structure over `boxes`, validates the BVHs, and checks that each one gives the
+/// same closest hit (same primitive, `t` within [`T_TOLERANCE`] relative) and the same any-hit
+/// answer as brute force for every ray, with counting on and off. Returns the first disagreement.
+pub fn check_all_structures(
+    boxes: &[Aabb],
+    rays: &[Ray],
+    intersect: impl Fn(u32, &Ray) -> Option<PrimHit> + Copy,
+) -> Result<(), String> {
+    let brute = AnyAccel::build(AccelKind::None, boxes);
+    let expected: Vec<(Option<Hit>, bool)> = rays
+        .iter()
+        .map(|r| {
+            (
+                brute.closest_hit(r, &mut NoCount, intersect),
+                brute.any_hit(r, &mut NoCount, |i, r| intersect(i, r).is_some()),
+            )
+        })
+        .collect();
+    for &kind in AccelKind::ALL {
+        let accel = AnyAccel::build(kind, boxes);
+        if let Some(bvh) = accel.bvh() {
+            validate_bvh(bvh, boxes).map_err(|e| format!("{kind}: invalid tree: {e}"))?;
+        }
+        for (ray, &(closest, any)) in rays.iter().zip(&expected) {
+            let got = accel.closest_hit(ray, &mut NoCount, intersect);
+            same_hit(closest, got).map_err(|e| format!("{kind}: closest hit of {ray:?}: {e}"))?;
+            let mut counts = WorkCounts::default();
+            let counted = accel.closest_hit(ray, &mut counts, intersect);
+            if counted != got {
+                return Err(format!("{kind}: counting changed the closest hit of {ray:?}: {got:?} then {counted:?}"));
+            }
+            let got_any = accel.any_hit(ray, &mut NoCount, |i, r| intersect(i, r).is_some());
+            if got_any != any {
+                return Err(format!("{kind}: any hit of {ray:?}: brute force says {any}, {kind} says {got_any}"));
+            }
+            if closest.is_some() && !any {
+                return Err(format!("brute force: a closest hit but no any hit for {ray:?}"));
+            }
+        }
+    }
+    Ok(())
+}
+
+fn same_hit(expected: Option<Hit>, got: Option<Hit>) -> Result<(), String> {
+    match (expected, got) {
+        (None, None) => Ok(()),
+        (Some(e), Some(g)) => {
+            let tolerance = T_TOLERANCE * e.t.abs().max(f32::MIN_POSITIVE);
+            if e.prim != g.prim || (e.t - g.t).abs() > tolerance {
+                Err(format!("expected primitive {} at t = {}, got primitive {} at t = {}", e.prim, e.t, g.prim, g.t))
+            } else {
+                Ok(())
+            }
+        }
+        (e, g) => Err(format!("expected {e:?}, got {g:?}")),
+    }
+}
+
+/// The shared data folder (`shared/`, holding `scenes/`): `ENGLOBE_SHARED` if set, otherwise the
+/// first ancestor of this crate that has a `shared/scenes` folder beside it. Panics (the test
+/// fails) if there is none: the tests that need it must not pass silently without it.
+pub fn shared_dir() -> PathBuf {
+    if let Some(dir) = std::env::var_os("ENGLOBE_SHARED") {
+        let dir = PathBuf::from(dir);
+        assert!(dir.join("scenes").is_dir(), "ENGLOBE_SHARED={} has no scenes folder", dir.display());
+        return dir;
+    }
+    let manifest = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    manifest.ancestors().map(|a| a.join("shared")).find(|s| s.join("scenes").is_dir()).unwrap_or_else(|| {
+        panic!("no shared/scenes folder beside any ancestor of {}; set ENGLOBE_SHARED", manifest.display())
+    })
+}
