@@ -2,7 +2,8 @@
 //!
 //! englobe's renderer: a pinhole camera, point and directional lights, Phong-style materials with
 //! mirrors and glass, the Whitted integrator of the seed report, tiled parallel rendering that
-//! gives the same bytes on any number of threads, and atomic PNG/EXR output.
+//! gives the same bytes on any number of threads, atomic PNG/EXR output, and the cost AOV: a
+//! false-colour picture of the work an acceleration structure does per pixel.
 //!
 //! ```
 //! # fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -14,7 +15,9 @@
 //! ```
 
 pub mod camera;
+pub mod cost;
 pub mod film;
+pub mod heatmap;
 pub mod optics;
 pub mod output;
 pub mod render;
@@ -22,7 +25,9 @@ pub mod stats;
 pub mod whitted;
 
 pub use camera::PinholeCamera;
+pub use cost::{CostImage, write_cost_image};
 pub use film::Film;
+pub use heatmap::{Heatmap, HeatmapScale};
 pub use output::{OutputError, OutputFormat, write_image};
 pub use render::{RenderError, RenderOutput, Renderer};
 pub use stats::{KindStats, RayKind, RenderStats};

@@ -2,6 +2,11 @@
 //! every pixel draws its samples from a generator seeded by the scene's seed and the pixel's
 //! position alone, and tiles are stitched back in a fixed order, so the image bytes and the
 //! counts are the same on 1 thread or many.
+//!
+//! On request the renderer also records the work of every pixel (the cost AOV, see
+//! [`crate::cost`]) and can render only a regular sample of the pixels (every `n`-th pixel of
+//! every `n`-th row), which times slow structures on large scenes; a pixel's value never depends
+//! on which other pixels are rendered.
 
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::time::Instant;
@@ -13,6 +18,7 @@ use rand_pcg::Pcg32;
 use rayon::prelude::*;
 
 use crate::camera::PinholeCamera;
+use crate::cost::CostImage;
 use crate::film::Film;
 use crate::stats::{RayKind, RenderStats, Tally};
 use crate::whitted::Whitted;
@@ -39,6 +45,8 @@ pub struct RenderOutput {
     pub complete: bool,
     /// Wall-clock seconds spent rendering.
     pub seconds: f64,
+    /// Work per pixel (nodes visited plus exact tests), if [`Renderer::record_cost`] asked for it.
+    pub cost: Option<CostImage>,
 }
 
 /// Renders a scene through its world: `Renderer::new(&scene, &world).size(640, 480).render()`.
@@ -49,6 +57,8 @@ pub struct Renderer<'a> {
     height: u32,
     samples: u32,
     count_work: bool,
+    record_cost: bool,
+    stride: u32,
     progress: Option<&'a (dyn Fn(usize, usize) + Sync)>,
     cancel: Option<&'a AtomicBool>,
 }
@@ -58,7 +68,18 @@ impl<'a> Renderer<'a> {
     /// order (see [`crate::build_world`]).
     pub fn new(scene: &'a Scene, world: &'a World) -> Self {
         let ImageSettings { width, height, samples, .. } = scene.image;
-        Renderer { scene, world, width, height, samples, count_work: false, progress: None, cancel: None }
+        Renderer {
+            scene,
+            world,
+            width,
+            height,
+            samples,
+            count_work: false,
+            record_cost: false,
+            stride: 1,
+            progress: None,
+            cancel: None,
+        }
     }
 
     /// Overrides the image size.
@@ -81,6 +102,21 @@ impl<'a> Renderer<'a> {
         self
     }
 
+    /// Records the work of every pixel (nodes visited plus exact tests, over all its rays) into
+    /// [`RenderOutput::cost`]. Implies counting; off by default, so a normal render pays nothing.
+    pub fn record_cost(mut self, on: bool) -> Self {
+        self.record_cost = on;
+        self
+    }
+
+    /// Renders only the pixels `(x, y)` with `x` and `y` multiples of `stride` (1, the default,
+    /// renders all); the others stay black and cost nothing. Statistics count the rendered pixels
+    /// only. Pixels rendered have the values a full render gives them.
+    pub fn pixel_stride(mut self, stride: u32) -> Self {
+        self.stride = stride.max(1);
+        self
+    }
+
     /// Calls `f(tiles_done, tiles_total)` after every tile, from any worker thread.
     pub fn on_progress(mut self, f: &'a (dyn Fn(usize, usize) + Sync)) -> Self {
         self.progress = Some(f);
@@ -97,7 +133,11 @@ impl<'a> Renderer<'a> {
     pub fn render(&self) -> Result<RenderOutput, RenderError> {
         ImageSettings::check_limits(self.width, self.height, self.samples, self.scene.image.max_depth)
             .map_err(RenderError::Limits)?;
-        if self.count_work { Ok(self.render_with::<WorkCounts>()) } else { Ok(self.render_with::<NoCount>()) }
+        if self.count_work || self.record_cost {
+            Ok(self.render_with::<WorkCounts>())
+        } else {
+            Ok(self.render_with::<NoCount>())
+        }
     }
 
     fn render_with<C: Counters + Copy + Send + Into<WorkCounts>>(&self) -> RenderOutput {
@@ -109,7 +149,7 @@ impl<'a> Renderer<'a> {
         let total = (tiles_x * tiles_y) as usize;
         let done = AtomicUsize::new(0);
 
-        let tiles: Vec<Option<(Vec<Vec3>, RenderStats)>> = (0..total)
+        let tiles: Vec<Option<TileOutput>> = (0..total)
             .into_par_iter()
             .map(|index| {
                 if self.cancel.is_some_and(|c| c.load(Ordering::Relaxed)) {
@@ -118,39 +158,60 @@ impl<'a> Renderer<'a> {
                 let (x0, y0) = ((index as u32 % tiles_x) * TILE_SIZE, (index as u32 / tiles_x) * TILE_SIZE);
                 let (x1, y1) = ((x0 + TILE_SIZE).min(self.width), (y0 + TILE_SIZE).min(self.height));
                 let mut tally = Tally::<C>::default();
-                let mut pixels = Vec::with_capacity(((x1 - x0) * (y1 - y0)) as usize);
+                let area = ((x1 - x0) * (y1 - y0)) as usize;
+                let mut pixels = Vec::with_capacity(area);
+                let mut cost = Vec::with_capacity(if self.record_cost { area } else { 0 });
                 for y in y0..y1 {
                     for x in x0..x1 {
-                        pixels.push(self.pixel(&camera, &integrator, x, y, &mut tally));
+                        if x % self.stride != 0 || y % self.stride != 0 {
+                            pixels.push(Vec3::ZERO);
+                            if self.record_cost {
+                                cost.push(0);
+                            }
+                        } else if self.record_cost {
+                            let before = tally.work_total();
+                            pixels.push(self.pixel(&camera, &integrator, x, y, &mut tally));
+                            let after = tally.work_total();
+                            cost.push(
+                                (after.nodes_visited + after.exact_tests) - (before.nodes_visited + before.exact_tests),
+                            );
+                        } else {
+                            pixels.push(self.pixel(&camera, &integrator, x, y, &mut tally));
+                        }
                     }
                 }
                 let n = done.fetch_add(1, Ordering::Relaxed) + 1;
                 if let Some(progress) = self.progress {
                     progress(n, total);
                 }
-                Some((pixels, tally.stats()))
+                Some(TileOutput { pixels, stats: tally.stats(), cost })
             })
             .collect();
 
         let mut film = Film::new(self.width, self.height);
+        let mut cost = self.record_cost.then(|| CostImage::new(self.width, self.height));
         let mut stats = RenderStats::default();
         let mut complete = true;
         for (index, tile) in tiles.into_iter().enumerate() {
-            let Some((pixels, tile_stats)) = tile else {
+            let Some(tile) = tile else {
                 complete = false;
                 continue;
             };
-            stats.add(&tile_stats);
+            stats.add(&tile.stats);
             let (x0, y0) = ((index as u32 % tiles_x) * TILE_SIZE, (index as u32 / tiles_x) * TILE_SIZE);
             let x1 = (x0 + TILE_SIZE).min(self.width);
-            let mut it = pixels.into_iter();
+            let mut it = tile.pixels.into_iter();
+            let mut work = tile.cost.into_iter();
             for y in y0..(y0 + TILE_SIZE).min(self.height) {
                 for x in x0..x1 {
                     film.set(x, y, it.next().expect("a tile holds all its pixels"));
+                    if let Some(cost) = cost.as_mut() {
+                        cost.set(x, y, work.next().expect("a tile holds the cost of all its pixels"));
+                    }
                 }
             }
         }
-        RenderOutput { film, stats, complete, seconds: start.elapsed().as_secs_f64() }
+        RenderOutput { film, stats, complete, seconds: start.elapsed().as_secs_f64(), cost }
     }
 
     fn pixel<C: Counters>(
@@ -176,7 +237,55 @@ impl<'a> Renderer<'a> {
     }
 }
 
+/// What one tile produced: its pixels row by row, its counts, and its pixels' work if recorded.
+struct TileOutput {
+    pixels: Vec<Vec3>,
+    stats: RenderStats,
+    cost: Vec<u64>,
+}
+
 /// The sample generator of one pixel: depends on the seed and the pixel only, never on threads.
 pub fn pixel_rng(seed: u64, x: u32, y: u32) -> Pcg32 {
     Pcg32::seed_from_u64(seed ^ ((y as u64) << 32 | x as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15))
+}
+
+#[cfg(test)]
+mod tests {
+    use englobe::AccelKind;
+
+    use super::*;
+
+    fn scene() -> Scene {
+        englobe_scene::parse_scene(crate::DEFAULT_SCENE, "default.toml".as_ref()).unwrap()
+    }
+
+    #[test]
+    fn cost_is_recorded_only_when_asked_and_adds_up_to_the_counts() {
+        let scene = scene();
+        let world = crate::build_world(&scene, AccelKind::BvhSeedOrdered).unwrap();
+        let plain = Renderer::new(&scene, &world).size(40, 30).samples(1).render().unwrap();
+        assert!(plain.cost.is_none());
+        let out = Renderer::new(&scene, &world).size(40, 30).samples(1).record_cost(true).render().unwrap();
+        let cost = out.cost.expect("recorded");
+        let total = out.stats.total();
+        assert_eq!(cost.total(), total.nodes_visited + total.exact_tests);
+        assert!(cost.values().iter().all(|&c| c > 0), "every pixel tests at least the plane");
+        assert_eq!(out.film, plain.film, "recording the cost does not change the image");
+    }
+
+    #[test]
+    fn a_pixel_stride_renders_the_same_pixels_and_only_them() {
+        let scene = scene();
+        let world = crate::build_world(&scene, AccelKind::None).unwrap();
+        let full = Renderer::new(&scene, &world).size(37, 29).count_work(true).render().unwrap();
+        let sample = Renderer::new(&scene, &world).size(37, 29).count_work(true).pixel_stride(4).render().unwrap();
+        for y in 0..29 {
+            for x in 0..37 {
+                let expected = if x % 4 == 0 && y % 4 == 0 { full.film.get(x, y) } else { Vec3::ZERO };
+                assert_eq!(sample.film.get(x, y), expected, "pixel ({x}, {y})");
+            }
+        }
+        let primary = sample.stats.kind(RayKind::Primary).rays;
+        assert_eq!(primary, 10 * 8 * scene.image.samples as u64);
+    }
 }

@@ -94,6 +94,16 @@ pub struct Tally<C: Counters> {
 }
 
 impl<C: Counters + Into<WorkCounts> + Copy> Tally<C> {
+    /// The work of all kinds of rays so far, summed.
+    #[inline]
+    pub fn work_total(&self) -> WorkCounts {
+        let mut total = WorkCounts::default();
+        for w in &self.work {
+            total += (*w).into();
+        }
+        total
+    }
+
     /// The counts as statistics.
     pub fn stats(&self) -> RenderStats {
         let mut s = RenderStats::default();
