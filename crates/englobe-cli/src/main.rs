@@ -1,9 +1,13 @@
 //! The `englobe` command: render scenes and measure how acceleration structures cut the work of
 //! ray tracing.
 
+mod compare_cmd;
+mod experiment_cmd;
+mod measure;
 mod progress;
 mod render_cmd;
 mod report;
+mod seed_report;
 
 use std::process::ExitCode;
 
@@ -21,12 +25,19 @@ struct Cli {
 enum Command {
     /// Render a scene file (or the embedded default scene) to PNG or EXR.
     Render(render_cmd::RenderArgs),
+    /// Run an experiment: `seed` renders the seed report's four tests with every accelerator and
+    /// prints its table beside the report's figures.
+    Experiment(experiment_cmd::ExperimentArgs),
+    /// Build every accelerator for one scene and compare build time, memory, speed and work.
+    Compare(compare_cmd::CompareArgs),
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Render(args) => render_cmd::run(args),
+        Command::Experiment(args) => experiment_cmd::run(args),
+        Command::Compare(args) => compare_cmd::run(args),
     };
     match result {
         Ok(code) => code,

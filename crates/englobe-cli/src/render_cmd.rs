@@ -5,9 +5,9 @@ use std::process::ExitCode;
 use std::time::Instant;
 
 use anyhow::Context;
-use clap::Args;
+use clap::{Args, ValueEnum};
 use englobe::AccelKind;
-use englobe_render::{Renderer, build_world, write_image};
+use englobe_render::{HeatmapScale, Renderer, build_world, write_cost_image, write_image};
 use englobe_scene::{Scene, load_scene, parse_scene};
 
 use crate::progress::tile_bar;
@@ -32,9 +32,20 @@ pub struct RenderArgs {
     /// Worker threads (default: all cores).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
     threads: Option<u32>,
-    /// Acceleration structure.
+    /// Acceleration structure: none (brute force), bvh-seed, bvh-seed-ordered, ...
     #[arg(long, default_value = "none", value_parser = parse_accel)]
     accel: AccelKind,
+    /// What the image shows: the shaded scene (color), or the structure's work per pixel (cost:
+    /// nodes visited plus exact tests, in false colour with a colour bar; raw counts in .exr).
+    #[arg(long, value_enum, default_value_t = Aov::Color)]
+    aov: Aov,
+    /// Cost drawn brightest with --aov cost (default: the image's largest), so that heatmaps of
+    /// several structures can share one scale.
+    #[arg(long, value_name = "N")]
+    cost_max: Option<u64>,
+    /// Scale of the cost heatmap.
+    #[arg(long, value_enum, default_value_t = CostScale::Log)]
+    cost_scale: CostScale,
     /// Print rays cast and exact intersection tests per kind of ray.
     #[arg(long)]
     stats: bool,
@@ -44,6 +55,24 @@ pub struct RenderArgs {
     /// No progress bar and no summary line.
     #[arg(short, long)]
     quiet: bool,
+}
+
+/// What `englobe render` writes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Aov {
+    /// The shaded image.
+    Color,
+    /// Work per pixel: nodes visited plus exact tests.
+    Cost,
+}
+
+/// Scale of the cost heatmap.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum CostScale {
+    /// ln(1 + cost) / ln(1 + max).
+    Log,
+    /// cost / max.
+    Linear,
 }
 
 pub fn parse_accel(s: &str) -> Result<AccelKind, String> {
@@ -87,13 +116,30 @@ pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
             .size(width, height)
             .samples(samples)
             .count_work(count_work)
+            .record_cost(args.aov == Aov::Cost)
             .on_progress(&progress)
             .render()
     })?;
     bar.finish_and_clear();
 
-    write_image(&out.film, &output)?;
+    let scale = match &out.cost {
+        Some(cost) => {
+            let max = args.cost_max.unwrap_or_else(|| cost.max());
+            let scale = match args.cost_scale {
+                CostScale::Log => HeatmapScale::log(max),
+                CostScale::Linear => HeatmapScale::linear(max),
+            };
+            Some(write_cost_image(cost, &output, scale)?)
+        }
+        None => {
+            write_image(&out.film, &output)?;
+            None
+        }
+    };
     if !args.quiet {
+        if let Some(scale) = scale {
+            println!("{}", scale.describe());
+        }
         println!(
             "wrote {} ({width}x{height}, {samples} spp, accel {}, {:.2} s on {} threads)",
             output.display(),

@@ -6,7 +6,7 @@
 //!
 //! * **Parallel rays.** A zero direction component has an inverse of `+inf` (see [`crate::Ray`]).
 //!   If the origin lies exactly on a slab plane, `(plane - origin) * inf` is NaN; the running
-//!   `max`/`min` below ignore NaN operands (Rust's `f32::max` returns the other operand), so a ray
+//!   `max`/`min` below ignore NaN operands (a comparison with NaN is false), so a ray
 //!   lying in a face counts as inside that slab, and a ray parallel to a slab but outside it gets
 //!   `+inf`/`-inf` entries and misses.
 //! * **Rounding.** The far distance is scaled by `1 + 2 * gamma(3)` (Ize 2013, "Robust BVH Ray
@@ -159,10 +159,12 @@ impl Aabb {
                 if inv[axis] >= 0.0 { (self.min[axis], self.max[axis]) } else { (self.max[axis], self.min[axis]) };
             let t_near = (near - o[axis]) * inv[axis];
             let t_far = (far - o[axis]) * inv[axis] * far_scale;
-            // `f32::max`/`min` return the non-NaN operand: a NaN (origin on the plane of a
-            // parallel ray) leaves the interval unchanged.
-            t_enter = t_enter.max(t_near);
-            t_exit = t_exit.min(t_far);
+            // A NaN (origin on the plane of a parallel ray) must leave the interval unchanged.
+            // A comparison with NaN is false, so these keep the running bound then, as
+            // `f32::max`/`min` would; unlike them they compile to a single `maxss`/`minss`, since
+            // the running bound (from a valid ray's interval) is never NaN itself.
+            t_enter = if t_near > t_enter { t_near } else { t_enter };
+            t_exit = if t_far < t_exit { t_far } else { t_exit };
         }
         (t_enter, t_exit)
     }

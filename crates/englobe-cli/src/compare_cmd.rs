@@ -1,0 +1,259 @@
+//! `englobe compare SCENE`: every structure of `AccelKind::ALL` built for one scene and used to
+//! render it: build time, memory, node count, depth, rays per second, and the work per ray (exact
+//! tests, nodes visited, box tests); then whether its image is brute force's, bit for bit.
+//!
+//! A structure whose full render would take longer than the time budget (brute force on a large
+//! mesh) is measured on a regular sample of the pixels instead: every `n`-th pixel of every
+//! `n`-th row, `n` a power of two chosen from a quick probe at a coarse stride. The table says so,
+//! and its image is compared with brute force's on the pixels both rendered.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::Args;
+use englobe::AccelKind;
+use englobe_render::{Film, RenderOutput};
+use englobe_scene::Scene;
+use serde::Serialize;
+
+use crate::measure::{RenderSettings, build, compare_films, render, thread_pool};
+use crate::render_cmd::{parse_accel, read_scene};
+use crate::report::{bytes, write_json};
+
+#[derive(Args)]
+pub struct CompareArgs {
+    /// Scene file (TOML, see docs/scene-format.md); the embedded default scene if omitted.
+    scene: Option<PathBuf>,
+    /// Image width in pixels (overrides the scene).
+    #[arg(long)]
+    width: Option<u32>,
+    /// Image height in pixels (overrides the scene).
+    #[arg(long)]
+    height: Option<u32>,
+    /// Samples per pixel (overrides the scene).
+    #[arg(long)]
+    spp: Option<u32>,
+    /// Only these accelerators, comma-separated (default: all); brute force (none) always runs, as
+    /// the reference.
+    #[arg(long, value_delimiter = ',', value_parser = parse_accel)]
+    accel: Vec<AccelKind>,
+    /// Worker threads (default: all cores).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
+    threads: Option<u32>,
+    /// Seconds one render may take before the structure is measured on a sample of the pixels.
+    #[arg(long, default_value_t = 10.0, value_name = "SECONDS")]
+    budget: f64,
+    /// Render every pixel with every structure, however long it takes.
+    #[arg(long)]
+    full: bool,
+    /// Also write the table as JSON to this file.
+    #[arg(long, value_name = "FILE")]
+    json: Option<PathBuf>,
+    /// No progress lines on standard error.
+    #[arg(short, long)]
+    quiet: bool,
+}
+
+/// One structure's line.
+#[derive(Clone, Debug, Serialize)]
+struct Row {
+    accel: &'static str,
+    build_seconds: f64,
+    memory_bytes: usize,
+    /// Interior nodes plus leaves.
+    nodes: usize,
+    leaves: usize,
+    depth: usize,
+    sah_cost: Option<f32>,
+    /// Rays of the timed render (all rays of the pixels rendered).
+    rays: u64,
+    /// Seconds of the timed render (counting off).
+    seconds: f64,
+    rays_per_second: f64,
+    exact_tests_per_ray: f64,
+    nodes_visited_per_ray: f64,
+    box_tests_per_ray: f64,
+    /// 1 when every pixel was rendered; `n` when only every `n`-th pixel of every `n`-th row was.
+    pixel_stride: u32,
+    sampled: bool,
+    /// Same image as brute force on every pixel both rendered.
+    image_equal: bool,
+    compared_pixels: usize,
+    differing_pixels: usize,
+}
+
+#[derive(Serialize)]
+struct CompareReport<'a> {
+    scene: &'a str,
+    primitives: usize,
+    width: u32,
+    height: u32,
+    samples: u32,
+    threads: usize,
+    budget_seconds: f64,
+    rows: Vec<Row>,
+}
+
+/// Coarsest stride of the probe render.
+const PROBE_STRIDE: u32 = 32;
+/// Fewest pixels a probe renders (the stride is refined until it has them).
+const PROBE_PIXELS: u64 = 256;
+
+pub fn run(args: CompareArgs) -> anyhow::Result<ExitCode> {
+    let (scene, scene_name) = read_scene(args.scene.as_ref())?;
+    let width = args.width.unwrap_or(scene.image.width);
+    let height = args.height.unwrap_or(scene.image.height);
+    let samples = args.spp.unwrap_or(scene.image.samples);
+    let settings = RenderSettings { width, height, samples, count_work: false, stride: 1 };
+    let mut kinds: Vec<AccelKind> =
+        AccelKind::ALL.iter().copied().filter(|k| args.accel.is_empty() || args.accel.contains(k)).collect();
+    if !kinds.contains(&AccelKind::None) {
+        kinds.insert(0, AccelKind::None);
+    }
+    let pool = thread_pool(args.threads)?;
+    let mut rows = Vec::new();
+    let mut reference: Option<(Film, u32)> = None;
+    let mut primitives = 0;
+    for kind in kinds {
+        if !args.quiet {
+            eprintln!("{kind}: building...");
+        }
+        let (world, build_seconds) = build(&scene, kind)?;
+        primitives = world.primitive_count();
+        let stride = if args.full { 1 } else { pool.install(|| choose_stride(&scene, &world, settings, args.budget))? };
+        if !args.quiet {
+            let sample =
+                if stride > 1 { format!(" on every {stride}th pixel of every {stride}th row") } else { String::new() };
+            eprintln!("{kind}: rendering{sample}...");
+        }
+        let timed = pool.install(|| render(&scene, &world, RenderSettings { stride, ..settings }))?;
+        let counted =
+            pool.install(|| render(&scene, &world, RenderSettings { stride, count_work: true, ..settings }))?;
+        let (film_ref, stride_ref) = reference.get_or_insert_with(|| (timed.film.clone(), stride));
+        let (compared, differing) = compare_films(film_ref, *stride_ref, &timed.film, stride);
+        rows.push(row(kind, build_seconds, &world.stats(), &timed, &counted, stride, compared, differing));
+    }
+    let threads = pool.current_num_threads();
+    print!("{}", table(&scene_name, primitives, width, height, samples, threads, &rows));
+    if let Some(path) = &args.json {
+        let report = CompareReport {
+            scene: &scene_name,
+            primitives,
+            width,
+            height,
+            samples,
+            threads,
+            budget_seconds: args.budget,
+            rows: rows.clone(),
+        };
+        write_json(path, &report)?;
+    }
+    if rows.iter().any(|r| !r.image_equal) {
+        eprintln!("error: some structures drew a different image than brute force");
+        return Ok(ExitCode::from(2));
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// The pixel stride that keeps one render within `budget` seconds: 1 if the full image fits,
+/// otherwise the smallest power of two whose sample fits, estimated from a probe render at a
+/// coarse stride.
+fn choose_stride(scene: &Scene, world: &englobe::World, settings: RenderSettings, budget: f64) -> anyhow::Result<u32> {
+    let sampled = |stride: u32| (settings.width.div_ceil(stride) as u64) * (settings.height.div_ceil(stride) as u64);
+    let mut probe = PROBE_STRIDE;
+    while probe > 1 && sampled(probe) < PROBE_PIXELS {
+        probe /= 2;
+    }
+    let out = render(scene, world, RenderSettings { stride: probe, ..settings })?;
+    let per_pixel = out.seconds / sampled(probe) as f64;
+    let mut stride = 1;
+    while stride < probe && per_pixel * sampled(stride) as f64 > budget {
+        stride *= 2;
+    }
+    Ok(stride)
+}
+
+#[allow(clippy::too_many_arguments)]
+fn row(
+    kind: AccelKind,
+    build_seconds: f64,
+    s: &englobe::accel::StructureStats,
+    timed: &RenderOutput,
+    counted: &RenderOutput,
+    stride: u32,
+    compared: usize,
+    differing: usize,
+) -> Row {
+    let work = counted.stats.total();
+    let per_ray = |n: u64| if work.rays == 0 { 0.0 } else { n as f64 / work.rays as f64 };
+    let rays = timed.stats.total().rays;
+    Row {
+        accel: kind.name(),
+        build_seconds,
+        memory_bytes: s.memory_bytes,
+        nodes: s.nodes + s.leaves,
+        leaves: s.leaves,
+        depth: s.depth,
+        sah_cost: s.sah_cost,
+        rays,
+        seconds: timed.seconds,
+        rays_per_second: if timed.seconds > 0.0 { rays as f64 / timed.seconds } else { 0.0 },
+        exact_tests_per_ray: per_ray(work.exact_tests),
+        nodes_visited_per_ray: per_ray(work.nodes_visited),
+        box_tests_per_ray: per_ray(work.box_tests),
+        pixel_stride: stride,
+        sampled: stride > 1,
+        image_equal: differing == 0,
+        compared_pixels: compared,
+        differing_pixels: differing,
+    }
+}
+
+fn table(scene: &str, primitives: usize, w: u32, h: u32, spp: u32, threads: usize, rows: &[Row]) -> String {
+    let mut out = format!(
+        "{scene}: {primitives} primitives in the structure, {w}x{h}, {spp} sample(s) per pixel, {threads} threads{}\n\n",
+        if cfg!(debug_assertions) { ", debug build (times are not representative)" } else { "" },
+    );
+    out += &format!(
+        "{:<18} {:>10} {:>10} {:>9} {:>6} {:>9} {:>10} {:>10} {:>10} {:>8}  {}\n",
+        "accelerator",
+        "build ms",
+        "memory",
+        "nodes",
+        "depth",
+        "Mrays/s",
+        "tests/ray",
+        "nodes/ray",
+        "boxes/ray",
+        "pixels",
+        "image"
+    );
+    out += &format!("{}\n", "-".repeat(120));
+    for r in rows {
+        let pixels = if r.sampled { format!("1/{}", r.pixel_stride * r.pixel_stride) } else { "all".to_owned() };
+        let image = match (r.accel == AccelKind::None.name(), r.image_equal) {
+            (true, _) => "reference".to_owned(),
+            (false, true) => "= none".to_owned(),
+            (false, false) => format!("{} of {} pixels differ", r.differing_pixels, r.compared_pixels),
+        };
+        out += &format!(
+            "{:<18} {:>10.2} {:>10} {:>9} {:>6} {:>9.3} {:>10.2} {:>10.2} {:>10.2} {:>8}  {}\n",
+            r.accel,
+            r.build_seconds * 1e3,
+            bytes(r.memory_bytes),
+            r.nodes,
+            r.depth,
+            r.rays_per_second / 1e6,
+            r.exact_tests_per_ray,
+            r.nodes_visited_per_ray,
+            r.box_tests_per_ray,
+            pixels,
+            image
+        );
+    }
+    if rows.iter().any(|r| r.sampled) {
+        out += "\npixels 1/N: too slow for the time budget (--budget), so timed and counted on a regular sample \
+                of 1 pixel in N (--full renders every pixel); images are compared on the pixels both rendered.\n";
+    }
+    out
+}

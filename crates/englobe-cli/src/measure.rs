@@ -1,0 +1,67 @@
+//! What `experiment` and `compare` share: building one structure for a scene and rendering with
+//! it, timed, and comparing the images of two structures.
+
+use std::time::Instant;
+
+use anyhow::Context;
+use englobe::{AccelKind, World};
+use englobe_render::{Film, RenderOutput, Renderer, build_world};
+use englobe_scene::Scene;
+
+/// How to render.
+#[derive(Clone, Copy, Debug)]
+pub struct RenderSettings {
+    /// Image width.
+    pub width: u32,
+    /// Image height.
+    pub height: u32,
+    /// Samples per pixel.
+    pub samples: u32,
+    /// Count the structure's work (slightly slower).
+    pub count_work: bool,
+    /// Render every `stride`-th pixel of every `stride`-th row only.
+    pub stride: u32,
+}
+
+/// Builds the world of the scene's objects under `kind`; returns it with the seconds it took
+/// (the primitives' boxes and the structure over them).
+pub fn build(scene: &Scene, kind: AccelKind) -> anyhow::Result<(World, f64)> {
+    let start = Instant::now();
+    let world = build_world(scene, kind).with_context(|| format!("cannot build {kind}"))?;
+    Ok((world, start.elapsed().as_secs_f64()))
+}
+
+/// Renders the scene through `world` on the current pool.
+pub fn render(scene: &Scene, world: &World, settings: RenderSettings) -> anyhow::Result<RenderOutput> {
+    Ok(Renderer::new(scene, world)
+        .size(settings.width, settings.height)
+        .samples(settings.samples)
+        .count_work(settings.count_work)
+        .pixel_stride(settings.stride)
+        .render()?)
+}
+
+/// Pixels rendered in both images (those at multiples of the larger of two power-of-two strides)
+/// and how many of them differ, bit for bit.
+pub fn compare_films(a: &Film, stride_a: u32, b: &Film, stride_b: u32) -> (usize, usize) {
+    let step = stride_a.max(stride_b).max(1);
+    let (mut compared, mut differing) = (0, 0);
+    for y in (0..a.height().min(b.height())).step_by(step as usize) {
+        for x in (0..a.width().min(b.width())).step_by(step as usize) {
+            compared += 1;
+            let (p, q) = (a.get(x, y), b.get(x, y));
+            if p.to_array().map(f32::to_bits) != q.to_array().map(f32::to_bits) {
+                differing += 1;
+            }
+        }
+    }
+    (compared, differing)
+}
+
+/// A worker pool of `threads` threads (all cores if `None`).
+pub fn thread_pool(threads: Option<u32>) -> anyhow::Result<rayon::ThreadPool> {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads.map_or(0, |t| t as usize))
+        .build()
+        .context("cannot start the worker threads")
+}

@@ -1,0 +1,150 @@
+//! `englobe experiment seed` and `englobe compare`, end to end, at a reduced size: the JSON has a
+//! row per test and accelerator, every image matches brute force, and the seed report's claims
+//! that are counts hold (times are never asserted).
+
+use std::process::Command;
+
+use englobe::AccelKind;
+use serde_json::Value;
+
+fn englobe() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_englobe"))
+}
+
+fn rows(report: &Value) -> &Vec<Value> {
+    report["rows"].as_array().expect("a rows array")
+}
+
+fn count(row: &Value, key: &str) -> u64 {
+    row[key].as_u64().unwrap_or_else(|| panic!("{key} in {row}"))
+}
+
+#[test]
+fn seed_experiment_reproduces_the_report_s_reductions() {
+    let dir = tempfile::tempdir().unwrap();
+    let json = dir.path().join("seed.json");
+    let out = englobe()
+        .args(["experiment", "seed", "--size", "128", "--quiet", "--json"])
+        .arg(&json)
+        .output()
+        .expect("englobe runs");
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{stdout}\n{}", String::from_utf8_lossy(&out.stderr));
+    for figure in ["2.51978e7", "1.61632e7", "1.83346e6", "422 762", "3.61592e7", "481 126"] {
+        assert!(stdout.contains(figure), "the report's {figure} is printed beside ours:\n{stdout}");
+    }
+
+    let report: Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let rows = rows(&report);
+    assert_eq!(rows.len(), 4 * AccelKind::ALL.len());
+    let find = |test: u64, accel: AccelKind| {
+        rows.iter()
+            .find(|r| r["test"].as_u64() == Some(test) && r["accel"].as_str() == Some(accel.name()))
+            .unwrap_or_else(|| panic!("no row for test {test} and {accel}"))
+    };
+    for test in 1..=4 {
+        let none = find(test, AccelKind::None);
+        for &kind in AccelKind::ALL {
+            let row = find(test, kind);
+            assert_eq!(row["image_identical"], Value::Bool(true), "test {test}, {kind}: {row}");
+            assert_eq!(count(row, "rays"), count(none, "rays"), "test {test}, {kind}: same image, same rays");
+            assert!(row["seconds"].as_f64().is_some());
+        }
+        // The ordered traversal tests fewer primitives than the report's on every test.
+        let (seed, ordered) = (find(test, AccelKind::BvhSeed), find(test, AccelKind::BvhSeedOrdered));
+        assert!(count(ordered, "exact_tests") < count(seed, "exact_tests"), "test {test}: {ordered} vs {seed}");
+    }
+    // The report's reductions, at least matched by its own structure and traversal.
+    for (test, percent) in [(1, 35.8), (2, 76.9), (3, 98.6)] {
+        let (none, seed) =
+            (count(find(test, AccelKind::None), "exact_tests"), count(find(test, AccelKind::BvhSeed), "exact_tests"));
+        let reduction = 100.0 * (1.0 - seed as f64 / none as f64);
+        assert!(reduction >= percent, "test {test}: {reduction:.1} % fewer exact tests, the report {percent} %");
+    }
+    // Test 4 in counts: the 8000 spheres out of view cost the seed BVH almost no exact test and
+    // brute force 1000 times more.
+    let tests = |test, kind| count(find(test, kind), "exact_tests") as f64;
+    assert!(tests(4, AccelKind::BvhSeed) < 1.1 * tests(1, AccelKind::BvhSeed));
+    assert!(tests(4, AccelKind::None) > 100.0 * tests(1, AccelKind::None));
+}
+
+#[test]
+fn experiment_runs_a_subset_and_refuses_unknown_names() {
+    let out = englobe()
+        .args(["experiment", "seed", "--size", "16", "--tests", "2", "--accel", "bvh-seed", "-q"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains("none") && stdout.contains("bvh-seed") && !stdout.contains("bvh-seed-ordered"), "{stdout}");
+    let out = englobe().args(["experiment", "seed", "--accel", "octree"]).output().unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("expected one of: none, bvh-seed"));
+    let out = englobe().args(["experiment", "seed", "--tests", "5"]).output().unwrap();
+    assert!(!out.status.success());
+}
+
+#[test]
+fn compare_lists_every_structure_and_samples_slow_ones() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/seed/test4.toml");
+    let json = dir.path().join("compare.json");
+    // A budget of zero seconds forces sampling of every structure.
+    let out = englobe()
+        .args(["compare", scene, "--width", "96", "--height", "96", "--budget", "0", "-q", "--json"])
+        .arg(&json)
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{stdout}\n{}", String::from_utf8_lossy(&out.stderr));
+    assert!(stdout.contains("regular sample"), "{stdout}");
+    let report: Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let rows = rows(&report);
+    let names: Vec<&str> = rows.iter().map(|r| r["accel"].as_str().unwrap()).collect();
+    assert_eq!(names, AccelKind::ALL.iter().map(|k| k.name()).collect::<Vec<_>>());
+    for row in rows {
+        for key in [
+            "build_seconds",
+            "memory_bytes",
+            "nodes",
+            "depth",
+            "rays_per_second",
+            "exact_tests_per_ray",
+            "nodes_visited_per_ray",
+        ] {
+            assert!(row[key].is_number(), "{key} in {row}");
+        }
+        assert_eq!(row["image_equal"], Value::Bool(true), "{row}");
+        assert!(row["pixel_stride"].as_u64().unwrap() > 1, "{row}");
+        assert!(row["compared_pixels"].as_u64().unwrap() > 0, "{row}");
+    }
+    let none = &rows[0];
+    assert_eq!(count(none, "nodes"), 0);
+    // Brute force tests every sphere for every ray but occluded shadow rays, which stop early.
+    assert!(none["exact_tests_per_ray"].as_f64().unwrap() > 4000.0, "{none}");
+    let seed = &rows[1];
+    assert_eq!(count(seed, "nodes"), 2 * 8007 - 1);
+    assert_eq!(count(seed, "depth"), 13);
+    assert!(seed["exact_tests_per_ray"].as_f64().unwrap() < 4.0, "{seed}");
+
+    // With the whole image, nothing is sampled.
+    let out = englobe().args(["compare", scene, "--width", "24", "--height", "24", "--full", "-q"]).output().unwrap();
+    assert!(out.status.success());
+    assert!(!String::from_utf8_lossy(&out.stdout).contains("regular sample"));
+}
+
+#[test]
+fn cost_aov_writes_a_heatmap_with_its_scale() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/seed/test1.toml");
+    let heat = dir.path().join("heat.png");
+    let out = englobe()
+        .args(["render", scene, "--accel", "bvh-seed", "--aov", "cost", "--width", "64", "--height", "64", "-o"])
+        .arg(&heat)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(String::from_utf8_lossy(&out.stdout).contains("viridis colormap, logarithmic scale"));
+    let png = std::fs::read(&heat).unwrap();
+    assert_eq!(&png[1..4], b"PNG");
+}
