@@ -122,8 +122,7 @@ pub fn run(args: CompareArgs) -> anyhow::Result<ExitCode> {
         primitives = world.primitive_count();
         let stride = if args.full { 1 } else { pool.install(|| choose_stride(&scene, &world, settings, args.budget))? };
         if !args.quiet {
-            let sample =
-                if stride > 1 { format!(" on every {stride}th pixel of every {stride}th row") } else { String::new() };
+            let sample = if stride > 1 { format!(" 1 pixel in {stride}x{stride}") } else { String::new() };
             eprintln!("{kind}: rendering{sample}...");
         }
         let timed = pool.install(|| render(&scene, &world, RenderSettings { stride, ..settings }))?;
