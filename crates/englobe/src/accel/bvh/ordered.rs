@@ -11,7 +11,10 @@
 //!
 //! The stack holds at most one entry per level of the path from the root, so the tree's recorded
 //! depth bounds it: trees up to [`INLINE_STACK`] deep use a fixed array on the call stack; deeper
-//! ones (only degenerate builds are) use one heap buffer for the query, never one per node.
+//! ones (only degenerate builds are) use a buffer kept per thread and grown to the depth once, so
+//! that no query allocates in the steady state and none can overflow.
+
+use std::cell::Cell;
 
 use super::Bvh;
 use crate::Ray;
@@ -25,6 +28,12 @@ pub const INLINE_STACK: usize = 64;
 /// A pending subtree: its node and the distance at which the ray enters its box.
 type Pending = (u32, f32);
 
+thread_local! {
+    /// The stack of queries on trees deeper than [`INLINE_STACK`], reused from query to query.
+    /// A query nested inside another's closure finds it taken and uses a fresh one.
+    static DEEP_STACK: Cell<Vec<Pending>> = const { Cell::new(Vec::new()) };
+}
+
 impl Bvh {
     /// Runs `query` with a traversal stack large enough for this tree.
     #[inline(always)]
@@ -34,7 +43,12 @@ impl Bvh {
             let mut inline = [(0u32, 0f32); INLINE_STACK];
             query(&mut inline)
         } else {
-            query(&mut vec![(0u32, 0f32); needed])
+            let mut stack = DEEP_STACK.with(Cell::take);
+            stack.clear();
+            stack.resize(needed, (0, 0.0));
+            let result = query(&mut stack);
+            DEEP_STACK.with(|kept| kept.set(stack));
+            result
         }
     }
 
