@@ -46,7 +46,7 @@ pub struct ExperimentArgs {
     /// Also write the table as JSON to this file.
     #[arg(long, value_name = "FILE")]
     json: Option<PathBuf>,
-    /// Write every image rendered into this folder, as test<N>-<accel>.png.
+    /// Write every image rendered into this folder, as testN-ACCEL.png.
     #[arg(long, value_name = "DIR")]
     images: Option<PathBuf>,
     /// No progress lines on standard error.
