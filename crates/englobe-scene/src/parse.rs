@@ -129,7 +129,7 @@ impl Converter<'_> {
             let span = t.span();
             let t = t.into_inner();
             let tri = Triangle::new(t.vertices[0].0, t.vertices[1].0, t.vertices[2].0);
-            if !(tri.double_area() > 0.0) {
+            if tri.double_area() <= 0.0 || tri.double_area().is_nan() {
                 return Err(
                     self.err(span, "a triangle needs three vertices that are not on one line (its area is zero)")
                 );
@@ -170,7 +170,7 @@ impl Converter<'_> {
         let position = c.position.0;
         let look_at = c.look_at.get_ref().0;
         let view = look_at - position;
-        if !(view.length() > 0.0) || !view.is_finite() {
+        if view.length() <= 0.0 || !view.is_finite() {
             return Err(self.err(c.look_at.span(), "the camera's look_at must differ from its position"));
         }
         let (up, up_span) = match &c.up {
@@ -178,7 +178,7 @@ impl Converter<'_> {
             None => (Vec3::Y, span.clone()),
         };
         let side = view.normalize().cross(up.normalize_or_zero());
-        if !(side.length() > 1e-6) {
+        if side.length() <= 1e-6 || side.is_nan() {
             return Err(self.err(
                 up_span,
                 format!("the camera's up vector {up} is zero or parallel to its view direction {view}"),

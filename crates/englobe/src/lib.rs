@@ -4,7 +4,7 @@
 //! englobants*: bounding volumes, the answer a 2009 student report gave to the question "which
 //! objects can a ray possibly hit?", and the thread this library follows.
 //!
-//! * Geometry: [`Ray`], [`Aabb`] and the [`shapes`] (sphere, plane, box, triangle, mesh).
+//! * Geometry: [`Ray`], [`Aabb`] and the [`shapes`] (sphere, plane, box, triangle, mesh, instance).
 //! * Acceleration structures behind one interface, [`accel::Accel`], with work counters.
 //! * [`World`]: objects plus a structure, answering closest-hit and any-hit queries.
 //!
@@ -25,10 +25,10 @@ pub mod world;
 
 pub use aabb::Aabb;
 pub use accel::{Accel, AccelKind, AnyAccel, Counters, Hit, NoCount, WorkCounts};
-pub use glam::{Vec2, Vec3};
+pub use glam::{Affine3A, Mat4, Vec2, Vec3};
 pub use ray::Ray;
-pub use shapes::{AaBox, Bounded, Intersect, Plane, PrimHit, Shape, Sphere, Triangle, TriangleMesh};
-pub use world::{Object, World, WorldError, WorldHit};
+pub use shapes::{AaBox, Bounded, Instance, Intersect, Plane, PrimHit, Shape, Sphere, Triangle, TriangleMesh};
+pub use world::{BottomLevel, Object, World, WorldError, WorldHit};
 
 // The README's examples are compiled and run as doctests.
 #[cfg(doctest)]

@@ -31,7 +31,7 @@ impl Intersect for AaBox {
         // The unwidened slab test over the whole line: a surface needs the exact crossing points.
         let line = ray.with_range(f32::NEG_INFINITY, f32::INFINITY);
         let (t_enter, t_exit) = self.bounds.slab_distances(&line, 1.0);
-        if !(t_enter <= t_exit) {
+        if t_enter > t_exit || t_enter.is_nan() || t_exit.is_nan() {
             return None;
         }
         // A ray starting inside (or on the surface going in) leaves through the far side.

@@ -1,13 +1,16 @@
 //! The shapes a ray can hit, each with its exact intersection, its normal and its own bounding box
-//! (the seed report's "one bounding-box function per kind of object").
+//! (the seed report's "one bounding-box function per kind of object"), plus meshes and instances
+//! of meshes.
 
 mod aabox;
+mod instance;
 mod mesh;
 mod plane;
 mod sphere;
 mod triangle;
 
 pub use aabox::AaBox;
+pub use instance::{Instance, InstanceError, transform_box};
 pub use mesh::{MeshError, TriangleMesh};
 pub use plane::Plane;
 pub use sphere::Sphere;

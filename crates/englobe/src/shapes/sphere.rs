@@ -38,7 +38,7 @@ impl Sphere {
         // Squared distance from the centre to the line, computed without cancellation.
         let l = f + d * (b / a);
         let discriminant = a * (r * r - l.dot(l));
-        if !(discriminant >= 0.0) {
+        if discriminant < 0.0 || discriminant.is_nan() {
             return None;
         }
         let c = f.dot(f) - r * r;

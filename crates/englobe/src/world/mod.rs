@@ -1,19 +1,23 @@
-//! A world: a list of objects (shapes and meshes) with an acceleration structure over their
-//! bounded primitives. It answers closest-hit and any-hit queries in terms of objects, which is
-//! what a renderer or any other user of ray queries needs.
+//! A world: a list of objects (shapes, meshes and mesh instances) with an acceleration structure
+//! over their bounded primitives. It answers closest-hit and any-hit queries in terms of objects,
+//! which is what a renderer or any other user of ray queries needs.
 //!
-//! Every bounded primitive (a sphere, a box, one triangle of a mesh) gets an index in the order
-//! the objects were given, and the structure is built over their boxes. Unbounded shapes (planes)
-//! stay outside the structure and are tested beside it, as the design of every production ray
-//! tracer does.
+//! Every bounded primitive (a sphere, a box, one triangle of a mesh, one whole instance) gets an
+//! index in the order the objects were given, and the structure is built over their boxes.
+//! Unbounded shapes (planes) stay outside the structure and are tested beside it, as the design of
+//! every production ray tracer does. Instances make a two-level hierarchy: see [`instances`].
 
 use std::sync::Arc;
 
 use glam::Vec3;
 
+mod instances;
+
 use crate::accel::{Accel, AccelKind, AnyAccel, Counters, HitRecord, MAX_PRIMITIVES, StructureStats};
-use crate::shapes::{Bounded, Intersect, PrimHit, Shape, TriangleMesh};
+use crate::shapes::{Bounded, Instance, Intersect, PrimHit, Shape, TriangleMesh};
 use crate::{Aabb, Ray};
+
+pub use instances::BottomLevel;
 
 /// One object of a world.
 #[derive(Clone, Debug, PartialEq)]
@@ -22,6 +26,9 @@ pub enum Object {
     Shape(Shape),
     /// A triangle mesh: each triangle is a primitive of its own.
     Mesh(Arc<TriangleMesh>),
+    /// A mesh placed by a transform: one primitive of the world's structure, traced through a
+    /// bottom-level structure over the mesh that all instances of the same mesh share.
+    Instance(Instance),
 }
 
 impl<S: Into<Shape>> From<S> for Object {
@@ -36,12 +43,28 @@ impl From<TriangleMesh> for Object {
     }
 }
 
+impl From<Instance> for Object {
+    fn from(i: Instance) -> Self {
+        Object::Instance(i)
+    }
+}
+
 impl Object {
-    /// Number of primitives the object contributes.
+    /// Number of primitives the object contributes to the world's structure.
     pub fn primitive_count(&self) -> usize {
         match self {
-            Object::Shape(_) => 1,
+            Object::Shape(_) | Object::Instance(_) => 1,
             Object::Mesh(m) => m.len(),
+        }
+    }
+
+    /// Number of triangles the object puts in the picture (an instance counts its mesh's).
+    pub fn triangle_count(&self) -> usize {
+        match self {
+            Object::Shape(Shape::Triangle(_)) => 1,
+            Object::Shape(_) => 0,
+            Object::Mesh(m) => m.len(),
+            Object::Instance(i) => i.mesh().len(),
         }
     }
 }
@@ -69,7 +92,8 @@ pub struct WorldHit {
     pub t: f32,
     /// Index of the object hit, in the order the objects were given.
     pub object: u32,
-    /// Index of the primitive within that object (the triangle of a mesh; 0 for shapes).
+    /// Index of the primitive within that object: the triangle of a mesh, the triangle of the
+    /// instanced mesh for an instance, 0 for shapes.
     pub prim: u32,
     /// First surface coordinate.
     pub u: f32,
@@ -89,10 +113,15 @@ pub struct World {
     unbounded: Vec<u32>,
     accel: AnyAccel,
     kind: AccelKind,
+    /// Bottom-level structures, one per distinct instanced mesh, shared by its instances.
+    bottom: Vec<BottomLevel>,
+    /// For each object, the index of its bottom-level structure (instances only).
+    object_bottom: Vec<u32>,
 }
 
 impl World {
-    /// Builds a world over `objects` with the structure `kind`.
+    /// Builds a world over `objects` with the structure `kind`. Instances of the same mesh (the
+    /// same `Arc`) share one bottom-level structure, also of kind `kind`.
     pub fn build(objects: Vec<Object>, kind: AccelKind) -> Result<World, WorldError> {
         let total: usize = objects
             .iter()
@@ -125,10 +154,17 @@ impl World {
                     boxes.extend((0..m.len() as u32).map(|t| m.triangle_bounds(t)));
                     prim_object.resize(boxes.len(), i as u32);
                 }
+                Object::Instance(inst) => {
+                    // Instance construction guarantees finite bounds.
+                    boxes.push(inst.bounds());
+                    prim_object.push(i as u32);
+                }
             }
         }
         let accel = AnyAccel::build(kind, &boxes);
-        Ok(World { objects, prim_object, object_first_prim, unbounded, accel, kind })
+        drop(boxes);
+        let (bottom, object_bottom) = instances::build_bottom_levels(&objects, kind);
+        Ok(World { objects, prim_object, object_first_prim, unbounded, accel, kind, bottom, object_bottom })
     }
 
     /// The objects, in the order given.
@@ -146,9 +182,19 @@ impl World {
         &self.accel
     }
 
-    /// Size and shape of the structure.
+    /// Size and shape of the (top-level) structure.
     pub fn stats(&self) -> StructureStats {
         self.accel.stats()
+    }
+
+    /// The bottom-level structures, one per distinct instanced mesh.
+    pub fn bottom_levels(&self) -> &[BottomLevel] {
+        &self.bottom
+    }
+
+    /// Triangles in the picture, every instance counting its mesh's.
+    pub fn triangle_count(&self) -> usize {
+        self.objects.iter().map(Object::triangle_count).sum()
     }
 
     /// Number of primitives in the structure (unbounded shapes not included).
@@ -167,24 +213,40 @@ impl World {
         (object, prim - self.object_first_prim[object as usize])
     }
 
-    #[inline(always)]
-    fn intersect_prim(&self, prim: u32, ray: &Ray) -> Option<PrimHit> {
-        let (object, local) = self.locate(prim);
-        match &self.objects[object as usize] {
-            Object::Shape(s) => s.intersect(ray),
-            Object::Mesh(m) => m.intersect(local, ray),
-        }
-    }
-
     /// The closest hit, or `None`. Ties at equal `t` go to the lower object (then primitive) index.
     pub fn closest_hit<C: Counters>(&self, ray: &Ray, counters: &mut C) -> Option<WorldHit> {
         if !ray.is_valid() {
             return None;
         }
-        let found = self.accel.closest_hit(ray, counters, |prim, r| self.intersect_prim(prim, r));
+        // Work inside instances is counted apart (the structure holds `counters` during its query)
+        // and merged afterwards.
+        let mut nested = C::default();
+        let mut instance_hits = instances::ClosestInstance::default();
+        let found = self.accel.closest_hit(ray, counters, |prim, r| {
+            let (object, local) = self.locate(prim);
+            match &self.objects[object as usize] {
+                Object::Shape(s) => s.intersect(r),
+                Object::Mesh(m) => m.intersect(local, r),
+                Object::Instance(inst) => {
+                    let hit = self.instance_closest_hit(object, inst, r, &mut nested)?;
+                    instance_hits.offer(prim, &hit);
+                    Some(PrimHit { t: hit.t, u: hit.u, v: hit.v })
+                }
+            }
+        });
+        counters.merge(&nested);
         let mut best = found.map(|h| {
             let (object, local) = self.locate(h.prim);
-            WorldHit { t: h.t, object, prim: local, u: h.u, v: h.v }
+            let prim = match &self.objects[object as usize] {
+                Object::Instance(inst) => instance_hits.triangle(h.prim, h.t).unwrap_or_else(|| {
+                    // Only a structure that breaks the tie rule of `HitRecord::offer` gets here:
+                    // ask the instance again, up to the hit.
+                    let r = ray.with_range(ray.t_min, h.t);
+                    self.instance_closest_hit(object, inst, &r, &mut C::default()).map_or(0, |x| x.prim)
+                }),
+                _ => local,
+            };
+            WorldHit { t: h.t, object, prim, u: h.u, v: h.v }
         });
         let mut record = HitRecord::new(ray.with_range(ray.t_min, best.map_or(ray.t_max, |b| b.t)));
         for &object in &self.unbounded {
@@ -213,10 +275,23 @@ impl World {
             counters.exact_test();
             match &self.objects[object as usize] {
                 Object::Shape(s) => s.intersect(ray).is_some(),
-                Object::Mesh(_) => false,
+                Object::Mesh(_) | Object::Instance(_) => false,
             }
         });
-        unbounded_hit || self.accel.any_hit(ray, counters, |prim, r| self.intersect_prim(prim, r).is_some())
+        if unbounded_hit {
+            return true;
+        }
+        let mut nested = C::default();
+        let hit = self.accel.any_hit(ray, counters, |prim, r| {
+            let (object, local) = self.locate(prim);
+            match &self.objects[object as usize] {
+                Object::Shape(s) => s.intersect(r).is_some(),
+                Object::Mesh(m) => m.intersect(local, r).is_some(),
+                Object::Instance(inst) => self.instance_any_hit(object, inst, r, &mut nested),
+            }
+        });
+        counters.merge(&nested);
+        hit
     }
 
     /// The unit geometric normal at the hit point `p` (outward for closed shapes, by winding for
@@ -225,6 +300,7 @@ impl World {
         match &self.objects[hit.object as usize] {
             Object::Shape(s) => s.normal(p, &PrimHit { t: hit.t, u: hit.u, v: hit.v }),
             Object::Mesh(m) => m.geometric_normal(hit.prim),
+            Object::Instance(i) => i.normal_to_world(i.mesh().geometric_normal(hit.prim)),
         }
     }
 
@@ -233,6 +309,7 @@ impl World {
     pub fn shading_normal(&self, hit: &WorldHit, p: Vec3) -> Vec3 {
         match &self.objects[hit.object as usize] {
             Object::Mesh(m) => m.shading_normal(hit.prim, hit.u, hit.v),
+            Object::Instance(i) => i.normal_to_world(i.mesh().shading_normal(hit.prim, hit.u, hit.v)),
             Object::Shape(_) => self.geometric_normal(hit, p),
         }
     }
