@@ -6,9 +6,11 @@
 
 pub mod error;
 pub mod format;
+pub mod mesh;
 pub mod model;
 pub mod numbers;
 pub mod parse;
+pub mod shared_data;
 
 pub use error::{Located, SceneError};
 pub use model::{
