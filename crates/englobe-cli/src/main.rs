@@ -3,7 +3,9 @@
 
 mod compare_cmd;
 mod experiment_cmd;
+mod info_cmd;
 mod measure;
+mod memory;
 mod progress;
 mod render_cmd;
 mod report;
@@ -30,6 +32,9 @@ enum Command {
     Experiment(experiment_cmd::ExperimentArgs),
     /// Build every accelerator for one scene and compare build time, memory, speed and work.
     Compare(compare_cmd::CompareArgs),
+    /// Say what a mesh file (.obj, .ply, .gltf, .glb) or a scene file (.toml) holds, or why it is
+    /// refused.
+    Info(info_cmd::InfoArgs),
 }
 
 fn main() -> ExitCode {
@@ -38,6 +43,7 @@ fn main() -> ExitCode {
         Command::Render(args) => render_cmd::run(args),
         Command::Experiment(args) => experiment_cmd::run(args),
         Command::Compare(args) => compare_cmd::run(args),
+        Command::Info(args) => info_cmd::run(args),
     };
     match result {
         Ok(code) => code,

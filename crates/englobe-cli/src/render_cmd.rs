@@ -10,6 +10,7 @@ use englobe::AccelKind;
 use englobe_render::{HeatmapScale, Renderer, build_world, write_cost_image, write_image};
 use englobe_scene::{Scene, load_scene, parse_scene};
 
+use crate::memory::peak_rss_bytes;
 use crate::progress::tile_bar;
 use crate::report::{StatsReport, stats_table, write_json};
 
@@ -89,6 +90,11 @@ pub fn read_scene(path: Option<&PathBuf>) -> anyhow::Result<(Scene, String)> {
 
 pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
     let (scene, scene_name) = read_scene(args.scene.as_ref())?;
+    if !args.quiet {
+        for w in &scene.warnings {
+            eprintln!("warning: {w}");
+        }
+    }
     let width = args.width.unwrap_or(scene.image.width);
     let height = args.height.unwrap_or(scene.image.height);
     let samples = args.spp.unwrap_or(scene.image.samples);
@@ -148,8 +154,13 @@ pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
             pool.current_num_threads()
         );
     }
+    let peak_memory_bytes = peak_rss_bytes();
     if args.stats {
         print!("{}", stats_table(&out.stats));
+        println!("triangles: {} in the picture; build {build_seconds:.3} s", world.triangle_count());
+        if let Some(bytes) = peak_memory_bytes {
+            println!("peak memory: {:.1} MiB", bytes as f64 / (1 << 20) as f64);
+        }
     }
     if let Some(path) = &args.stats_json {
         let report = StatsReport {
@@ -160,6 +171,8 @@ pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
             samples,
             build_seconds,
             render_seconds: out.seconds,
+            triangles: world.triangle_count(),
+            peak_memory_bytes,
             kinds: StatsReport::rows(&out.stats),
             total: out.stats.total(),
         };

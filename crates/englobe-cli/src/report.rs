@@ -16,6 +16,10 @@ pub struct StatsReport<'a> {
     pub samples: u32,
     pub build_seconds: f64,
     pub render_seconds: f64,
+    /// Triangles in the picture (every instance counting its mesh's).
+    pub triangles: usize,
+    /// Peak resident memory of the process, where the system reports it.
+    pub peak_memory_bytes: Option<u64>,
     pub kinds: Vec<KindRow>,
     pub total: KindStats,
 }

@@ -30,8 +30,10 @@ impl<'a> Whitted<'a> {
         Whitted { scene, world }
     }
 
+    /// The material at a hit: the object's, or its triangle's when the mesh gives one per triangle.
     fn material(&self, hit: &WorldHit) -> &Material {
-        &self.scene.materials[self.scene.objects[hit.object as usize].material as usize]
+        let id = self.scene.objects[hit.object as usize].material_of(hit.prim);
+        &self.scene.materials[id as usize]
     }
 
     /// The colour seen along `ray`, a ray of `kind` at recursion `depth` (0 for primary rays).

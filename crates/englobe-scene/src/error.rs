@@ -19,6 +19,15 @@ pub enum SceneError {
     /// The file was read but its content is wrong at a known place.
     #[error("{0}")]
     Invalid(Located),
+    /// A mesh file the scene names could not be loaded: the place is the scene's `[[mesh]]` entry,
+    /// the source says what is wrong with the mesh file, and where.
+    #[error("{located}")]
+    Mesh {
+        /// The scene entry, with a message that includes the mesh error.
+        located: Located,
+        /// The mesh file's own error (already part of `located`'s message).
+        mesh: Box<crate::mesh::MeshFileError>,
+    },
 }
 
 /// A message about one place of one file.
@@ -56,18 +65,25 @@ impl fmt::Display for Located {
     }
 }
 
-impl SceneError {
-    /// An error at byte range `span` of `text` (the start of the range is reported).
+impl Located {
+    /// The place of byte range `span` of `text` (its start), with `message`.
     pub fn at(file: &str, text: &str, span: Option<Range<usize>>, message: impl Into<String>) -> Self {
         let offset = span.map_or(0, |s| s.start).min(text.len());
         let (line, column, source_line) = line_and_column(text, offset);
-        SceneError::Invalid(Located { file: file.to_owned(), line, column, message: message.into(), source_line })
+        Located { file: file.to_owned(), line, column, message: message.into(), source_line }
+    }
+}
+
+impl SceneError {
+    /// An error at byte range `span` of `text` (the start of the range is reported).
+    pub fn at(file: &str, text: &str, span: Option<Range<usize>>, message: impl Into<String>) -> Self {
+        SceneError::Invalid(Located::at(file, text, span, message))
     }
 
     /// The place of the error, when it has one.
     pub fn location(&self) -> Option<&Located> {
         match self {
-            SceneError::Invalid(l) => Some(l),
+            SceneError::Invalid(l) | SceneError::Mesh { located: l, .. } => Some(l),
             SceneError::Io { .. } => None,
         }
     }

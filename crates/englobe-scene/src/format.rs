@@ -7,7 +7,7 @@ use std::collections::BTreeMap;
 use serde::Deserialize;
 use toml::Spanned;
 
-use crate::numbers::{Color, Finite, Fraction, NonNegative, Point, Positive};
+use crate::numbers::{Color, Finite, Fraction, Matrix, NonNegative, Point, Positive, Scale};
 
 /// A whole scene file.
 #[derive(Debug, Deserialize)]
@@ -31,6 +31,8 @@ pub struct SceneFile {
     pub boxes: Vec<Spanned<BoxDef>>,
     #[serde(default)]
     pub triangle: Vec<Spanned<TriangleDef>>,
+    #[serde(default)]
+    pub mesh: Vec<Spanned<MeshDef>>,
 }
 
 fn one() -> u32 {
@@ -131,4 +133,38 @@ pub struct BoxDef {
 pub struct TriangleDef {
     pub vertices: [Point; 3],
     pub material: Option<Spanned<String>>,
+}
+
+/// A mesh file placed in the scene, once or many times.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MeshDef {
+    pub path: Spanned<String>,
+    pub translate: Option<Point>,
+    pub rotate: Option<Point>,
+    pub scale: Option<Scale>,
+    pub matrix: Option<Matrix>,
+    pub material: Option<Spanned<String>>,
+    pub instances: Option<Vec<Spanned<TransformDef>>>,
+    pub grid: Option<Spanned<GridDef>>,
+}
+
+/// A placement: translate, rotate (degrees), scale, or a 4x4 matrix.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TransformDef {
+    pub translate: Option<Point>,
+    pub rotate: Option<Point>,
+    pub scale: Option<Scale>,
+    pub matrix: Option<Matrix>,
+}
+
+/// Instances on a regular grid.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GridDef {
+    pub counts: [u32; 3],
+    pub spacing: Point,
+    pub origin: Option<Point>,
+    pub rotate_step: Option<Point>,
 }

@@ -1,8 +1,9 @@
 //! # englobe-scene
 //!
 //! englobe's scene files: a small TOML format (documented key by key in `docs/scene-format.md`)
-//! read into a validated [`Scene`]. A bad file is refused with an error that names the file, the
-//! line and the column and says what was expected; nothing here panics on user input.
+//! read into a validated [`Scene`], and the mesh files scenes name ([`mesh`]: OBJ + MTL, PLY,
+//! glTF 2.0). A bad file is refused with an error that names the file, the line (or byte) and
+//! says what was expected; nothing here panics on user input.
 
 pub mod error;
 pub mod format;
@@ -10,6 +11,7 @@ pub mod mesh;
 pub mod model;
 pub mod numbers;
 pub mod parse;
+mod parse_mesh;
 pub mod shared_data;
 
 pub use error::{Located, SceneError};
@@ -17,3 +19,4 @@ pub use model::{
     Camera, ImageSettings, Light, MAX_DEPTH, MAX_PIXELS, MAX_SAMPLES, Material, MaterialId, Scene, SceneObject,
 };
 pub use parse::{DEFAULT_MATERIAL, load_scene, parse_scene};
+pub use parse_mesh::MAX_MESH_INSTANCES;

@@ -2,6 +2,8 @@
 //! within limits, numbers are finite, the camera is not degenerate and every object's material
 //! exists.
 
+use std::sync::Arc;
+
 use englobe::{Object, Vec3};
 
 /// Largest image, in pixels (2^28: a 16384 x 16384 image), refused before anything is allocated.
@@ -126,6 +128,26 @@ pub struct SceneObject {
     pub object: Object,
     /// Its material.
     pub material: MaterialId,
+    /// For meshes whose file gives each triangle a material (OBJ with several, glTF): one id per
+    /// triangle of the mesh (of the instanced mesh for an instance), which replaces `material`.
+    /// Instances of one mesh share the array.
+    pub triangle_materials: Option<Arc<[MaterialId]>>,
+}
+
+impl SceneObject {
+    /// An object with one material.
+    pub fn new(object: Object, material: MaterialId) -> Self {
+        SceneObject { object, material, triangle_materials: None }
+    }
+
+    /// The material of primitive `prim` of the object (the triangle of a mesh or instance).
+    #[inline]
+    pub fn material_of(&self, prim: u32) -> MaterialId {
+        match &self.triangle_materials {
+            Some(ids) => ids.get(prim as usize).copied().unwrap_or(self.material),
+            None => self.material,
+        }
+    }
 }
 
 /// A complete, validated scene.
@@ -143,4 +165,6 @@ pub struct Scene {
     pub material_names: Vec<String>,
     /// Objects.
     pub objects: Vec<SceneObject>,
+    /// What was skipped or repaired while loading (from mesh files, mostly), for the user.
+    pub warnings: Vec<String>,
 }

@@ -2,7 +2,7 @@
 //! line and column: every number must be finite and fit `f32`, and some must be positive or lie
 //! in `0..=1`.
 
-use englobe::Vec3;
+use englobe::{Affine3A, Mat4, Vec3};
 use serde::de::Error;
 use serde::{Deserialize, Deserializer};
 
@@ -93,5 +93,52 @@ impl<'de> Deserialize<'de> for Color {
     fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
         let [r, g, b] = <[NonNegative; 3]>::deserialize(d)?;
         Ok(Color(Vec3::new(r.0, g.0, b.0)))
+    }
+}
+
+/// A scale: one number for all axes or three, none of them zero (a zero scale flattens the mesh
+/// and cannot be undone when rays are moved into its space).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Scale(pub Vec3);
+
+impl<'de> Deserialize<'de> for Scale {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        #[derive(Deserialize)]
+        #[serde(untagged)]
+        enum Either {
+            One(f64),
+            Three([f64; 3]),
+        }
+        let v = match Either::deserialize(d).map_err(|_| D::Error::custom("expected a number or [x, y, z]"))? {
+            Either::One(s) => [s; 3],
+            Either::Three(v) => v,
+        };
+        let mut out = Vec3::ZERO;
+        for (k, x) in v.into_iter().enumerate() {
+            if !x.is_finite() || x.abs() > f32::MAX as f64 || x as f32 == 0.0 {
+                return Err(D::Error::custom(format!("a scale must be finite and not zero, found {x}")));
+            }
+            out[k] = x as f32;
+        }
+        Ok(Scale(out))
+    }
+}
+
+/// An affine 4x4 matrix written row by row: four rows of four finite numbers, the last row
+/// `[0, 0, 0, 1]`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Matrix(pub Affine3A);
+
+impl<'de> Deserialize<'de> for Matrix {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let rows = <[[Finite; 4]; 4]>::deserialize(d)?;
+        let last = rows[3].map(|x| x.0);
+        if last != [0.0, 0.0, 0.0, 1.0] {
+            return Err(D::Error::custom(format!(
+                "the matrix's last row is {last:?}; an affine transform needs [0, 0, 0, 1]"
+            )));
+        }
+        let m = Mat4::from_cols_array_2d(&rows.map(|r| r.map(|x| x.0))).transpose();
+        Ok(Matrix(Affine3A::from_mat4(m)))
     }
 }

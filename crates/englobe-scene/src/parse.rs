@@ -45,16 +45,18 @@ pub fn parse_scene(text: &str, file: &Path) -> Result<Scene, SceneError> {
     let name = file.display().to_string();
     let def: SceneFile =
         toml::from_str(text).map_err(|e| SceneError::at(&name, text, e.span(), e.message().to_owned()))?;
-    Converter { file: &name, text }.scene(def)
+    Converter { file: &name, text, dir: file.parent().unwrap_or(Path::new("")) }.scene(def)
 }
 
-struct Converter<'a> {
-    file: &'a str,
-    text: &'a str,
+pub(crate) struct Converter<'a> {
+    pub(crate) file: &'a str,
+    pub(crate) text: &'a str,
+    /// The scene file's folder, against which mesh paths are resolved.
+    pub(crate) dir: &'a Path,
 }
 
 impl Converter<'_> {
-    fn err(&self, span: Range<usize>, message: impl Into<String>) -> SceneError {
+    pub(crate) fn err(&self, span: Range<usize>, message: impl Into<String>) -> SceneError {
         SceneError::at(self.file, self.text, Some(span), message)
     }
 
@@ -82,7 +84,7 @@ impl Converter<'_> {
         }
 
         let mut objects = Vec::new();
-        let mut push = |object: Object, material| objects.push(SceneObject { object, material });
+        let mut push = |object: Object, material| objects.push(SceneObject::new(object, material));
         for s in def.sphere {
             push(Sphere::new(s.center.0, s.radius.0).into(), lookup(&s.material)?);
         }
@@ -136,7 +138,9 @@ impl Converter<'_> {
             }
             push(tri.into(), lookup(&t.material)?);
         }
-        Ok(Scene { image, camera, lights, materials, material_names, objects })
+        let mut scene = Scene { image, camera, lights, materials, material_names, objects, warnings: Vec::new() };
+        self.meshes(def.mesh, &mut scene)?;
+        Ok(scene)
     }
 
     fn image(&self, image: Spanned<ImageDef>) -> Result<ImageSettings, SceneError> {

@@ -125,8 +125,7 @@ pub struct MeshFileError {
     pub path: PathBuf,
     /// Where in it, when known.
     pub at: Option<Position>,
-    /// What was wrong.
-    #[source]
+    /// What was wrong (its message is part of this error's, so it is not a separate source).
     pub kind: MeshErrorKind,
 }
 

@@ -147,7 +147,8 @@ fn split_glb<'a>(path: &Path, bytes: &'a [u8]) -> Result<(&'a [u8], Option<&'a [
 }
 
 /// englobe's materials for the document's: base colour factor as diffuse, emissive factor as
-/// emission.
+/// emission. Textures are not read; an emissive factor that only scales an emissive texture
+/// (which then says where the surface glows) is dropped rather than lighting the whole surface.
 fn materials(root: &json::Root) -> Vec<NamedMaterial> {
     root.materials
         .iter()
@@ -157,7 +158,11 @@ fn materials(root: &json::Root) -> Vec<NamedMaterial> {
             let finite = |v: Vec3| if v.is_finite() { v.max(Vec3::ZERO) } else { Vec3::ZERO };
             let material = Material {
                 diffuse: finite(Vec3::new(r, g, b)),
-                emission: finite(Vec3::from(m.emissive_factor.0)),
+                emission: if m.emissive_texture.is_some() {
+                    Vec3::ZERO
+                } else {
+                    finite(Vec3::from(m.emissive_factor.0))
+                },
                 ..Material::default()
             };
             (m.name.clone().unwrap_or_else(|| format!("material {i}")), material)

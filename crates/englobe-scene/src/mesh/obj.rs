@@ -49,12 +49,7 @@ pub(super) fn load(path: &Path, bytes: Vec<u8>) -> Result<LoadedMesh, MeshFileEr
     }
     let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
     let libraries = RefCell::new(Libraries::default());
-    let options = tobj::LoadOptions {
-        single_index: true,
-        triangulate: false,
-        ignore_points: true,
-        ignore_lines: true,
-    };
+    let options = tobj::LoadOptions { single_index: true, triangulate: false, ignore_points: true, ignore_lines: true };
     let parsed = guarded(path, "OBJ", || {
         tobj::load_obj_buf(&mut text.as_bytes(), &options, |p| load_library(&dir, p, &libraries))
     })?;

@@ -144,8 +144,16 @@ impl TriangleMesh {
     /// The watertight test of the ray against triangle `i`.
     #[inline(always)]
     pub fn intersect(&self, i: u32, ray: &Ray) -> Option<PrimHit> {
+        self.intersect_with(i, ray, &WatertightRay::new(ray))
+    }
+
+    /// The watertight test of the ray against triangle `i`, with the ray's constants `w` computed
+    /// once for all the triangles a query tests (they depend on the direction only, which stays
+    /// the same while a query shrinks `t_max`).
+    #[inline(always)]
+    pub fn intersect_with(&self, i: u32, ray: &Ray, w: &WatertightRay) -> Option<PrimHit> {
         let t = self.triangle(i);
-        intersect_triangle(ray, &WatertightRay::new(ray), t.vertices[0], t.vertices[1], t.vertices[2])
+        intersect_triangle(ray, w, t.vertices[0], t.vertices[1], t.vertices[2])
     }
 
     /// The unit geometric normal of triangle `i` (zero for a degenerate one).

@@ -15,7 +15,7 @@ use std::sync::Arc;
 
 use super::{Object, World};
 use crate::accel::{Accel, AccelKind, AnyAccel, Counters, Hit, StructureStats};
-use crate::shapes::{Instance, TriangleMesh};
+use crate::shapes::{Instance, TriangleMesh, WatertightRay};
 
 /// A structure over the triangles of one mesh, in the mesh's own space.
 #[derive(Clone, Debug)]
@@ -103,7 +103,8 @@ impl World {
         counters.box_tests(1);
         bottom.accel.bounds().intersect(&local)?;
         let mesh = &bottom.mesh;
-        bottom.accel.closest_hit(&local, counters, |tri, r| mesh.intersect(tri, r))
+        let w = WatertightRay::new(&local);
+        bottom.accel.closest_hit(&local, counters, |tri, r| mesh.intersect_with(tri, r, &w))
     }
 
     /// Whether `ray` hits the mesh of `inst` within its interval.
@@ -122,7 +123,8 @@ impl World {
             return false;
         }
         let mesh = &bottom.mesh;
-        bottom.accel.any_hit(&local, counters, |tri, r| mesh.intersect(tri, r).is_some())
+        let w = WatertightRay::new(&local);
+        bottom.accel.any_hit(&local, counters, |tri, r| mesh.intersect_with(tri, r, &w).is_some())
     }
 }
 

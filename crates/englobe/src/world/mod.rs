@@ -14,7 +14,7 @@ use glam::Vec3;
 mod instances;
 
 use crate::accel::{Accel, AccelKind, AnyAccel, Counters, HitRecord, MAX_PRIMITIVES, StructureStats};
-use crate::shapes::{Bounded, Instance, Intersect, PrimHit, Shape, TriangleMesh};
+use crate::shapes::{Bounded, Instance, Intersect, PrimHit, Shape, TriangleMesh, WatertightRay};
 use crate::{Aabb, Ray};
 
 pub use instances::BottomLevel;
@@ -222,11 +222,12 @@ impl World {
         // and merged afterwards.
         let mut nested = C::default();
         let mut instance_hits = instances::ClosestInstance::default();
+        let w = WatertightRay::new(ray);
         let found = self.accel.closest_hit(ray, counters, |prim, r| {
             let (object, local) = self.locate(prim);
             match &self.objects[object as usize] {
                 Object::Shape(s) => s.intersect(r),
-                Object::Mesh(m) => m.intersect(local, r),
+                Object::Mesh(m) => m.intersect_with(local, r, &w),
                 Object::Instance(inst) => {
                     let hit = self.instance_closest_hit(object, inst, r, &mut nested)?;
                     instance_hits.offer(prim, &hit);
@@ -282,11 +283,12 @@ impl World {
             return true;
         }
         let mut nested = C::default();
+        let w = WatertightRay::new(ray);
         let hit = self.accel.any_hit(ray, counters, |prim, r| {
             let (object, local) = self.locate(prim);
             match &self.objects[object as usize] {
                 Object::Shape(s) => s.intersect(r).is_some(),
-                Object::Mesh(m) => m.intersect(local, r).is_some(),
+                Object::Mesh(m) => m.intersect_with(local, r, &w).is_some(),
                 Object::Instance(inst) => self.instance_any_hit(object, inst, r, &mut nested),
             }
         });

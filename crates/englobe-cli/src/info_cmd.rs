@@ -1,0 +1,139 @@
+//! `englobe info FILE`: what a mesh file or a scene file holds (triangles, vertices, bounds,
+//! materials, instances, warnings), or the error that refuses it.
+
+use std::collections::HashSet;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use clap::Args;
+use englobe::{Aabb, Bounded, Object, Shape, TriangleMesh};
+use englobe_scene::mesh::{LoadedMesh, load_mesh_file};
+use englobe_scene::{Scene, load_scene};
+
+#[derive(Args)]
+pub struct InfoArgs {
+    /// A mesh file (.obj, .ply, .gltf, .glb) or a scene file (.toml).
+    file: PathBuf,
+}
+
+pub fn run(args: InfoArgs) -> anyhow::Result<ExitCode> {
+    let is_scene = args.file.extension().is_some_and(|e| e.eq_ignore_ascii_case("toml"));
+    let text = if is_scene {
+        scene_info(&args.file, &load_scene(&args.file)?)
+    } else {
+        mesh_info(&args.file, &load_mesh_file(&args.file)?)
+    };
+    print!("{text}");
+    Ok(ExitCode::SUCCESS)
+}
+
+fn bounds_lines(out: &mut String, b: &Aabb) {
+    if b.is_empty() {
+        let _ = writeln!(out, "bounds:     (empty)");
+    } else {
+        let _ = writeln!(out, "bounds:     min {} max {}", b.min, b.max);
+        let _ = writeln!(out, "size:       {}", b.extent());
+    }
+}
+
+fn warnings_lines(out: &mut String, warnings: &[String]) {
+    let _ = writeln!(out, "warnings:   {}", warnings.len());
+    for w in warnings {
+        let _ = writeln!(out, "  - {w}");
+    }
+}
+
+/// The description of a loaded mesh file.
+pub fn mesh_info(path: &Path, m: &LoadedMesh) -> String {
+    let mut out = String::new();
+    let mesh = &m.mesh;
+    let _ = writeln!(out, "file:       {}", path.display());
+    let _ = writeln!(out, "format:     {}", m.format.name());
+    let _ = writeln!(out, "triangles:  {}", mesh.len());
+    let _ = writeln!(out, "vertices:   {}", mesh.positions().len());
+    let yes = |b: bool| if b { "yes" } else { "no" };
+    let _ = writeln!(out, "normals:    {}", yes(mesh.normals().is_some()));
+    let _ = writeln!(out, "uvs:        {}", yes(mesh.uvs().is_some()));
+    bounds_lines(&mut out, &mesh.bounds());
+    let _ = writeln!(out, "memory:     {} bytes (vertices, triangles and attributes)", mesh_bytes(mesh));
+    let _ = writeln!(out, "materials:  {}", m.materials.len());
+    for (i, (name, mat)) in m.materials.iter().enumerate() {
+        let used = m.triangle_materials.as_ref().map_or(0, |ids| ids.iter().filter(|&&id| id == i as u32).count());
+        let _ = writeln!(out, "  - {name}: diffuse {}, emission {}, {used} triangles", mat.diffuse, mat.emission);
+    }
+    warnings_lines(&mut out, &m.warnings);
+    out
+}
+
+/// Bytes held by a mesh's arrays.
+pub fn mesh_bytes(m: &TriangleMesh) -> usize {
+    std::mem::size_of_val(m.positions())
+        + std::mem::size_of_val(m.triangles())
+        + m.normals().map_or(0, std::mem::size_of_val)
+        + m.uvs().map_or(0, std::mem::size_of_val)
+}
+
+/// The description of a loaded scene.
+pub fn scene_info(path: &Path, scene: &Scene) -> String {
+    let mut out = String::new();
+    let (mut spheres, mut planes, mut boxes, mut triangles, mut meshes, mut instances) = (0, 0, 0, 0, 0, 0);
+    let mut shown_triangles = 0usize;
+    let mut distinct: HashSet<*const TriangleMesh> = HashSet::new();
+    let (mut stored_triangles, mut stored_bytes) = (0usize, 0usize);
+    let mut bounds = Aabb::EMPTY;
+    for o in &scene.objects {
+        shown_triangles += o.object.triangle_count();
+        let mesh = match &o.object {
+            Object::Shape(s) => {
+                match s {
+                    Shape::Sphere(_) => spheres += 1,
+                    Shape::Plane(_) => planes += 1,
+                    Shape::AaBox(_) => boxes += 1,
+                    Shape::Triangle(_) => triangles += 1,
+                }
+                if s.is_bounded() {
+                    bounds = bounds.union(&s.bounds());
+                }
+                None
+            }
+            Object::Mesh(m) => {
+                meshes += 1;
+                bounds = bounds.union(&m.bounds());
+                Some(m)
+            }
+            Object::Instance(i) => {
+                instances += 1;
+                bounds = bounds.union(&i.bounds());
+                Some(i.mesh())
+            }
+        };
+        if let Some(m) = mesh {
+            if distinct.insert(std::sync::Arc::as_ptr(m)) {
+                stored_triangles += m.len();
+                stored_bytes += mesh_bytes(m);
+            }
+        }
+    }
+    let _ = writeln!(out, "file:       {}", path.display());
+    let _ = writeln!(
+        out,
+        "image:      {}x{}, {} spp, depth {}",
+        scene.image.width, scene.image.height, scene.image.samples, scene.image.max_depth
+    );
+    let _ = writeln!(out, "lights:     {}", scene.lights.len());
+    let _ = writeln!(out, "objects:    {}", scene.objects.len());
+    let _ = writeln!(
+        out,
+        "  spheres {spheres}, planes {planes}, boxes {boxes}, triangles {triangles}, meshes {meshes}, instances {instances}"
+    );
+    let _ = writeln!(out, "triangles:  {shown_triangles} in the picture, {stored_triangles} stored");
+    let _ = writeln!(out, "meshes:     {} distinct, {stored_bytes} bytes of mesh data", distinct.len());
+    bounds_lines(&mut out, &bounds);
+    let _ = writeln!(out, "materials:  {}", scene.materials.len());
+    for name in &scene.material_names {
+        let _ = writeln!(out, "  - {name}");
+    }
+    warnings_lines(&mut out, &scene.warnings);
+    out
+}
