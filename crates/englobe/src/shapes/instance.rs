@@ -42,6 +42,22 @@ pub struct Instance {
 
 impl Instance {
     /// The mesh `mesh` moved by `to_world` (mesh space to world space).
+    ///
+    /// ```
+    /// use std::sync::Arc;
+    /// use englobe::{AccelKind, Affine3A, Instance, NoCount, Ray, TriangleMesh, Vec3, World};
+    ///
+    /// let tri = Arc::new(TriangleMesh::new(vec![Vec3::ZERO, Vec3::X, Vec3::Y], vec![[0, 1, 2]])?);
+    /// // The same triangle twice, 5 and 10 units away: one mesh, two transforms.
+    /// let objects = [5.0, 10.0]
+    ///     .map(|z| Instance::new(tri.clone(), Affine3A::from_translation(Vec3::new(0.0, 0.0, z))).unwrap().into());
+    /// let world = World::build(objects.to_vec(), AccelKind::None)?;
+    /// let hit = world.closest_hit(&Ray::new(Vec3::new(0.2, 0.2, 0.0), Vec3::Z), &mut NoCount).unwrap();
+    /// assert_eq!((hit.object, hit.prim), (0, 0));
+    /// assert!((hit.t - 5.0).abs() < 1e-5);
+    /// assert_eq!(world.bottom_levels().len(), 1);
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
     pub fn new(mesh: Arc<TriangleMesh>, to_world: Affine3A) -> Result<Self, InstanceError> {
         if mesh.is_empty() {
             return Err(InstanceError::EmptyMesh);

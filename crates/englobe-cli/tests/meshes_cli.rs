@@ -1,0 +1,117 @@
+//! The `englobe` command on meshes: `info` on mesh and scene files, errors and exit codes, and
+//! the memory cost of instancing measured on the example scenes.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use englobe_scene::shared_data::shared_meshes_or_panic;
+
+fn englobe(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_englobe")).args(args).output().expect("the englobe binary runs")
+}
+
+fn repo() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn text(bytes: &[u8]) -> String {
+    String::from_utf8_lossy(bytes).into_owned()
+}
+
+#[test]
+fn info_describes_mesh_files() {
+    let bunny = shared_meshes_or_panic(&repo()).join("bunny/bun_zipper_binary.ply");
+    let out = englobe(&["info", bunny.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let shown = text(&out.stdout);
+    for line in ["format:     PLY", "triangles:  69451", "vertices:   34834", "warnings:   0"] {
+        assert!(shown.contains(line), "{line:?} missing from:\n{shown}");
+    }
+    let cornell = shared_meshes_or_panic(&repo()).join("cornell-box/CornellBox-Original.obj");
+    let shown = text(&englobe(&["info", cornell.to_str().unwrap()]).stdout);
+    assert!(
+        shown.contains("materials:  8")
+            && shown.contains("light: diffuse [0.78, 0.78, 0.78], emission [17, 12, 4], 2 triangles"),
+        "{shown}"
+    );
+}
+
+#[test]
+fn info_refuses_broken_files_with_a_non_zero_exit() {
+    let dir = tempfile::tempdir().unwrap();
+    let obj = dir.path().join("bad.obj");
+    std::fs::write(&obj, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 999999\n").unwrap();
+    let out = englobe(&["info", obj.to_str().unwrap()]);
+    assert!(!out.status.success());
+    let err = text(&out.stderr);
+    assert!(err.contains(&format!("{}: line 4: vertex index 999999 is out of range", obj.display())), "{err}");
+    let out = englobe(&["info", dir.path().join("absent.glb").to_str().unwrap()]);
+    assert!(!out.status.success() && text(&out.stderr).contains("absent.glb"));
+}
+
+#[test]
+fn info_and_render_name_the_scene_line_of_a_missing_mesh() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("s.toml");
+    std::fs::write(
+        &scene,
+        "[image]\nwidth = 4\nheight = 4\n[camera]\nposition = [0, 0, -5]\nlook_at = [0, 0, 0]\n[[mesh]]\npath = \"gone.ply\"\n",
+    )
+    .unwrap();
+    for args in [vec!["info"], vec!["render", "-q", "-o", dir.path().join("x.png").to_str().unwrap()]] {
+        let mut args = args;
+        args.push(scene.to_str().unwrap());
+        let out = englobe(&args);
+        assert!(!out.status.success(), "{args:?}");
+        let err = text(&out.stderr);
+        assert!(err.contains(&format!("{}:8:8: cannot load the mesh `gone.ply`", scene.display())), "{err}");
+        assert!(err.contains(&dir.path().join("gone.ply").display().to_string()), "{err}");
+    }
+    assert!(!dir.path().join("x.png").exists());
+}
+
+#[test]
+fn info_describes_the_instanced_field() {
+    let out = englobe(&["info", repo().join("scenes/bunny-field.toml").to_str().unwrap()]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let shown = text(&out.stdout);
+    assert!(shown.contains("meshes 0, instances 1000"), "{shown}");
+    assert!(shown.contains("triangles:  69451000 in the picture, 69451 stored"), "{shown}");
+    assert!(shown.contains("meshes:     1 distinct"), "{shown}");
+}
+
+/// Peak resident memory of `englobe render` on `scene` (a tiny image: the cost measured is the
+/// scene's, not the film's), from its statistics.
+fn peak_memory(scene: &str, dir: &Path) -> u64 {
+    let json = dir.join(format!("{scene}.json"));
+    let out = englobe(&[
+        "render",
+        "-q",
+        "--width",
+        "8",
+        "--height",
+        "8",
+        "--threads",
+        "1",
+        "-o",
+        dir.join(format!("{scene}.png")).to_str().unwrap(),
+        "--stats-json",
+        json.to_str().unwrap(),
+        repo().join(format!("scenes/{scene}.toml")).to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let stats: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(json).unwrap()).unwrap();
+    stats["peak_memory_bytes"].as_u64().expect("peak memory is reported on Linux")
+}
+
+#[cfg(target_os = "linux")]
+#[test]
+fn a_thousand_instanced_bunnies_cost_little_more_than_one() {
+    let dir = tempfile::tempdir().unwrap();
+    let one = peak_memory("bunny", dir.path());
+    let thousand = peak_memory("bunny-field", dir.path());
+    println!("peak memory: one bunny {one} bytes, 1000 instanced bunnies {thousand} bytes");
+    assert!(thousand < 3 * one, "1000 bunnies take {thousand} bytes, one takes {one}");
+    // A thousand copies of the bunny's triangles alone would take over a gigabyte.
+    assert!(thousand < 200 << 20, "{thousand}");
+}
