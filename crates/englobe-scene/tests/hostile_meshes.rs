@@ -187,6 +187,17 @@ fn ply_crlf_and_big_endian_files_load_like_the_plain_ones() {
 }
 
 #[test]
+fn text_files_without_a_final_newline_or_with_a_byte_order_mark_load() {
+    let dir = tempfile::tempdir().unwrap();
+    let m = load(dir.path(), "tight.ply", &ply("ascii", 3, 1, "uchar", b"0 0 0\n1 0 0\n0 1 0\n3 0 1 2")).unwrap();
+    assert_eq!(m.mesh.len(), 1);
+    let m = load(dir.path(), "bom.obj", format!("\u{feff}{TRIANGLE}f 1 2 3").as_bytes()).unwrap();
+    assert_eq!(m.mesh.positions().len(), 3);
+    let e = refused(dir.path(), "latin1.obj", b"v 0 0 0\n# caf\xe9\n");
+    assert_eq!(e.byte_offset(), Some(13), "{e}");
+}
+
+#[test]
 fn ply_extra_properties_are_skipped_and_normals_kept() {
     let dir = tempfile::tempdir().unwrap();
     let text = "ply\nformat ascii 1.0\ncomment made by hand\nelement vertex 4\nproperty float x\nproperty float y\n\

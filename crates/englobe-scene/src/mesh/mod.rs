@@ -125,10 +125,13 @@ pub(crate) fn read_limited(path: &Path, limit: u64) -> Result<Vec<u8>, MeshFileE
     std::fs::read(path).map_err(io)
 }
 
-/// `bytes` as UTF-8 text, or an error at the first invalid byte.
-pub(crate) fn utf8_text(path: &Path, bytes: Vec<u8>) -> Result<String, MeshFileError> {
+/// `bytes` as UTF-8 text without its byte-order mark, if any (which would otherwise hide the
+/// first statement), or an error at the first invalid byte.
+pub(crate) fn utf8_text(path: &Path, mut bytes: Vec<u8>) -> Result<String, MeshFileError> {
+    const BOM: &[u8] = b"\xEF\xBB\xBF";
+    let skipped = if bytes.starts_with(BOM) { bytes.drain(..BOM.len()).count() as u64 } else { 0 };
     String::from_utf8(bytes).map_err(|e| {
-        let at = e.utf8_error().valid_up_to() as u64;
+        let at = e.utf8_error().valid_up_to() as u64 + skipped;
         MeshFileError::byte(path, at, MeshErrorKind::Malformed("the file is not valid UTF-8 text".into()))
     })
 }

@@ -244,8 +244,9 @@ fn check_sizes(path: &Path, header: &Header, file_len: u64) -> Result<(), MeshFi
         };
         let needed = e.count.saturating_mul(per_item).saturating_add(needed_so_far);
         // An element with no property takes no byte: it still may not declare more than 2^32
-        // instances, which englobe could not index.
-        if needed > available || e.count > u32::MAX as u64 {
+        // instances, which englobe could not index. (The last ASCII value may lack its
+        // separator, hence the one byte of slack.)
+        if needed > available.saturating_add(1) || e.count > u32::MAX as u64 {
             return Err(MeshFileError::line(
                 path,
                 e.line,

@@ -7,9 +7,9 @@
 use englobe::Vec3;
 use glam::{DVec2, DVec3};
 
-/// Polygons with more vertices than this are fanned without the concavity test, which keeps the
-/// quadratic ear search bounded on hostile input.
-const MAX_EAR_CLIPPED: usize = 1024;
+/// Polygons with more vertices than this are fanned without the concavity test: the ear search
+/// costs up to the cube of the vertex count, and a hostile file could hold many huge polygons.
+pub(super) const MAX_EAR_CLIPPED: usize = 64;
 
 /// Appends the triangles of the polygon `poly` (vertex indices into `positions`, in order) to
 /// `out`, keeping its winding. Returns true if the polygon was concave and ear-clipped.
