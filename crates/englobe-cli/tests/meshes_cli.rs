@@ -70,9 +70,22 @@ fn info_and_render_name_the_scene_line_of_a_missing_mesh() {
     assert!(!dir.path().join("x.png").exists());
 }
 
+/// A copy of the example scene `name` in `dir`, reading its meshes from wherever the shared data
+/// was found (the example files name it relative to the repository, `../shared`).
+fn example_scene(name: &str, dir: &Path) -> PathBuf {
+    let text = std::fs::read_to_string(repo().join(format!("scenes/{name}.toml"))).unwrap();
+    let meshes = shared_meshes_or_panic(&repo());
+    assert!(text.contains("\"../../shared/scenes/meshes/"), "{name} does not read the shared meshes");
+    let text = text.replace("\"../../shared/scenes/meshes/", &format!("\"{}/", meshes.display()));
+    let file = dir.join(format!("{name}.toml"));
+    std::fs::write(&file, text).unwrap();
+    file
+}
+
 #[test]
 fn info_describes_the_instanced_field() {
-    let out = englobe(&["info", repo().join("scenes/bunny-field.toml").to_str().unwrap()]);
+    let dir = tempfile::tempdir().unwrap();
+    let out = englobe(&["info", example_scene("bunny-field", dir.path()).to_str().unwrap()]);
     assert!(out.status.success(), "{}", text(&out.stderr));
     let shown = text(&out.stdout);
     assert!(shown.contains("meshes 0, instances 1000"), "{shown}");
@@ -97,7 +110,7 @@ fn peak_memory(scene: &str, dir: &Path) -> u64 {
         dir.join(format!("{scene}.png")).to_str().unwrap(),
         "--stats-json",
         json.to_str().unwrap(),
-        repo().join(format!("scenes/{scene}.toml")).to_str().unwrap(),
+        example_scene(scene, dir).to_str().unwrap(),
     ]);
     assert!(out.status.success(), "{}", text(&out.stderr));
     let stats: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(json).unwrap()).unwrap();

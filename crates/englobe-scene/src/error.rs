@@ -8,19 +8,18 @@ use std::path::{Path, PathBuf};
 #[derive(Debug, thiserror::Error)]
 pub enum SceneError {
     /// The file could not be read.
-    #[error("{}: cannot read: {source}", path.display())]
+    #[error("{}: cannot read: {error}", path.display())]
     Io {
         /// The file.
         path: PathBuf,
-        /// What the system said.
-        #[source]
-        source: std::io::Error,
+        /// What the system said (already part of the message, so not a separate source).
+        error: std::io::Error,
     },
     /// The file was read but its content is wrong at a known place.
     #[error("{0}")]
     Invalid(Located),
     /// A mesh file the scene names could not be loaded: the place is the scene's `[[mesh]]` entry,
-    /// the source says what is wrong with the mesh file, and where.
+    /// `mesh` says what is wrong with the mesh file, and where.
     #[error("{located}")]
     Mesh {
         /// The scene entry, with a message that includes the mesh error.
@@ -89,8 +88,8 @@ impl SceneError {
     }
 
     /// An error reading `path`.
-    pub fn io(path: &Path, source: std::io::Error) -> Self {
-        SceneError::Io { path: path.to_owned(), source }
+    pub fn io(path: &Path, error: std::io::Error) -> Self {
+        SceneError::Io { path: path.to_owned(), error }
     }
 }
 

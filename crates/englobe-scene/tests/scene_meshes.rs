@@ -103,6 +103,7 @@ fn missing_unreadable_and_broken_meshes_name_the_scene_line_and_the_file() {
     let dir = folder();
     std::fs::create_dir(dir.path().join("folder.obj")).unwrap();
     std::fs::write(dir.path().join("broken.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n").unwrap();
+    std::fs::write(dir.path().join("notes.txt"), "not a mesh\n").unwrap();
     for (path, says) in [
         ("missing.obj", "No such file"),
         ("folder.obj", "directory"),

@@ -91,6 +91,7 @@ pub struct LoadedMesh {
 
 /// Reads and checks the mesh file `path`, choosing the format by its extension.
 pub fn load_mesh_file(path: &Path) -> Result<LoadedMesh, MeshFileError> {
+    check_file(path, MAX_MESH_FILE_BYTES)?;
     let Some(format) = MeshFormat::from_path(path) else {
         let ext = path.extension().map_or(String::new(), |e| e.to_string_lossy().into_owned());
         let kind = if ext.eq_ignore_ascii_case("mtl") {
@@ -112,8 +113,8 @@ pub fn load_mesh_file(path: &Path) -> Result<LoadedMesh, MeshFileError> {
     }
 }
 
-/// The bytes of `path`, refusing directories and files over `limit` bytes before reading.
-pub(crate) fn read_limited(path: &Path, limit: u64) -> Result<Vec<u8>, MeshFileError> {
+/// Refuses a `path` that does not exist, is a directory or is over `limit` bytes.
+fn check_file(path: &Path, limit: u64) -> Result<(), MeshFileError> {
     let io = |e| MeshFileError::file(path, MeshErrorKind::Io(e));
     let meta = std::fs::metadata(path).map_err(io)?;
     if meta.is_dir() {
@@ -122,7 +123,13 @@ pub(crate) fn read_limited(path: &Path, limit: u64) -> Result<Vec<u8>, MeshFileE
     if meta.len() > limit {
         return Err(MeshFileError::file(path, MeshErrorKind::FileTooLarge { bytes: meta.len(), limit }));
     }
-    std::fs::read(path).map_err(io)
+    Ok(())
+}
+
+/// The bytes of `path`, refusing directories and files over `limit` bytes before reading.
+pub(crate) fn read_limited(path: &Path, limit: u64) -> Result<Vec<u8>, MeshFileError> {
+    check_file(path, limit)?;
+    std::fs::read(path).map_err(|e| MeshFileError::file(path, MeshErrorKind::Io(e)))
 }
 
 /// `bytes` as UTF-8 text without its byte-order mark, if any (which would otherwise hide the
