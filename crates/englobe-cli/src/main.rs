@@ -4,6 +4,7 @@
 mod compare_cmd;
 mod experiment_cmd;
 mod info_cmd;
+mod interrupt;
 mod measure;
 mod memory;
 mod progress;

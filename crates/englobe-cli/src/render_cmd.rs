@@ -10,6 +10,7 @@ use englobe::AccelKind;
 use englobe_render::{HeatmapScale, Renderer, build_world, write_cost_image, write_image};
 use englobe_scene::{Scene, load_scene, parse_scene};
 
+use crate::interrupt;
 use crate::memory::peak_rss_bytes;
 use crate::progress::tile_bar;
 use crate::report::{StatsReport, stats_table, write_json};
@@ -89,6 +90,7 @@ pub fn read_scene(path: Option<&PathBuf>) -> anyhow::Result<(Scene, String)> {
 }
 
 pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
+    let interrupted = interrupt::install()?;
     let (scene, scene_name) = read_scene(args.scene.as_ref())?;
     if !args.quiet {
         for w in &scene.warnings {
@@ -124,9 +126,18 @@ pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
             .count_work(count_work)
             .record_cost(args.aov == Aov::Cost)
             .on_progress(&progress)
+            .cancel_flag(interrupted)
             .render()
     })?;
     bar.finish_and_clear();
+    if !out.complete {
+        eprintln!(
+            "interrupted: stopped after {} of {tiles} tiles; no image written ({} left as it was)",
+            bar.position(),
+            output.display()
+        );
+        return Ok(ExitCode::from(interrupt::INTERRUPTED_EXIT_CODE));
+    }
 
     let scale = match &out.cost {
         Some(cost) => {

@@ -167,3 +167,40 @@ fn exr_output_is_linear_float() {
     let img = image::open(dir.path().join("hdr.exr")).unwrap().to_rgb32f();
     assert_eq!(img.dimensions(), (16, 12));
 }
+
+#[cfg(unix)]
+#[test]
+fn ctrl_c_stops_with_code_130_and_writes_nothing() {
+    use std::time::{Duration, Instant};
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("keep.png"), b"a good image").unwrap();
+    // Thousands of samples per pixel: far more work than the test waits for.
+    let mut child = Command::new(env!("CARGO_BIN_EXE_englobe"))
+        .args(["render", "--spp", "20000", "--accel", "none", "-o", "keep.png"])
+        .current_dir(dir.path())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(Duration::from_millis(1500));
+    let sent = Command::new("kill").args(["-INT", &child.id().to_string()]).status().unwrap();
+    assert!(sent.success());
+    // A guard, not a measurement: a render that ignored Ctrl-C would run for many minutes.
+    let start = Instant::now();
+    let status = loop {
+        if let Some(status) = child.try_wait().unwrap() {
+            break status;
+        }
+        if start.elapsed() > Duration::from_secs(120) {
+            child.kill().unwrap();
+            panic!("the render did not stop after Ctrl-C");
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    };
+    let mut err = String::new();
+    std::io::Read::read_to_string(child.stderr.as_mut().unwrap(), &mut err).unwrap();
+    assert_eq!(status.code(), Some(130), "{err}");
+    assert!(err.contains("interrupted: stopped after"), "{err}");
+    assert_eq!(std::fs::read(dir.path().join("keep.png")).unwrap(), b"a good image");
+    let leftovers: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
+    assert_eq!(leftovers.len(), 1, "no temporary file is left behind");
+}

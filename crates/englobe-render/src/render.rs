@@ -123,7 +123,8 @@ impl<'a> Renderer<'a> {
         self
     }
 
-    /// Stops starting new tiles once `flag` is set; the output then says it is incomplete.
+    /// Stops the render once `flag` is set: every worker gives up at its next pixel, so the render
+    /// returns within about one pixel's time, and the output says it is incomplete.
     pub fn cancel_flag(mut self, flag: &'a AtomicBool) -> Self {
         self.cancel = Some(flag);
         self
@@ -148,13 +149,11 @@ impl<'a> Renderer<'a> {
         let tiles_y = self.height.div_ceil(TILE_SIZE);
         let total = (tiles_x * tiles_y) as usize;
         let done = AtomicUsize::new(0);
+        let cancelled = || self.cancel.is_some_and(|c| c.load(Ordering::Relaxed));
 
         let tiles: Vec<Option<TileOutput>> = (0..total)
             .into_par_iter()
             .map(|index| {
-                if self.cancel.is_some_and(|c| c.load(Ordering::Relaxed)) {
-                    return None;
-                }
                 let (x0, y0) = ((index as u32 % tiles_x) * TILE_SIZE, (index as u32 / tiles_x) * TILE_SIZE);
                 let (x1, y1) = ((x0 + TILE_SIZE).min(self.width), (y0 + TILE_SIZE).min(self.height));
                 let mut tally = Tally::<C>::default();
@@ -163,6 +162,9 @@ impl<'a> Renderer<'a> {
                 let mut cost = Vec::with_capacity(if self.record_cost { area } else { 0 });
                 for y in y0..y1 {
                     for x in x0..x1 {
+                        if cancelled() {
+                            return None;
+                        }
                         if x % self.stride != 0 || y % self.stride != 0 {
                             pixels.push(Vec3::ZERO);
                             if self.record_cost {
