@@ -8,7 +8,7 @@ use anyhow::Context;
 use clap::{Args, ValueEnum};
 use englobe::AccelKind;
 use englobe_render::{HeatmapScale, Renderer, build_world, write_cost_image, write_image};
-use englobe_scene::{Scene, load_scene, parse_scene};
+use englobe_scene::{IntegratorKind, Scene, load_scene, parse_scene};
 
 use crate::interrupt;
 use crate::memory::peak_rss_bytes;
@@ -37,6 +37,10 @@ pub struct RenderArgs {
     /// Acceleration structure: none (brute force), bvh-seed, bvh-seed-ordered, ...
     #[arg(long, default_value = "none", value_parser = parse_accel)]
     accel: AccelKind,
+    /// Light transport: whitted (the seed's recursion) or path (Monte Carlo path tracing);
+    /// overrides the scene's `integrator`.
+    #[arg(long, value_parser = parse_integrator)]
+    integrator: Option<IntegratorKind>,
     /// What the image shows: the shaded scene (color), or the structure's work per pixel (cost:
     /// nodes visited plus exact tests, in false colour with a colour bar; raw counts in .exr).
     #[arg(long, value_enum, default_value_t = Aov::Color)]
@@ -77,6 +81,14 @@ pub enum CostScale {
     Linear,
 }
 
+fn parse_integrator(s: &str) -> Result<IntegratorKind, String> {
+    match s {
+        "whitted" => Ok(IntegratorKind::Whitted),
+        "path" => Ok(IntegratorKind::Path),
+        _ => Err(format!("unknown integrator `{s}`; expected whitted or path")),
+    }
+}
+
 pub fn parse_accel(s: &str) -> Result<AccelKind, String> {
     s.parse().map_err(|e: englobe::accel::UnknownAccel| e.to_string())
 }
@@ -100,6 +112,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
     let width = args.width.unwrap_or(scene.image.width);
     let height = args.height.unwrap_or(scene.image.height);
     let samples = args.spp.unwrap_or(scene.image.samples);
+    let integrator = args.integrator.unwrap_or(scene.image.integrator);
     let output = args.output.clone().unwrap_or_else(|| {
         let stem = args.scene.as_ref().and_then(|p| p.file_stem()).map_or("englobe".into(), |s| s.to_os_string());
         PathBuf::from(stem).with_extension("png")
@@ -123,6 +136,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
         Renderer::new(&scene, &world)
             .size(width, height)
             .samples(samples)
+            .integrator(integrator)
             .count_work(count_work)
             .record_cost(args.aov == Aov::Cost)
             .on_progress(&progress)
@@ -158,8 +172,9 @@ pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
             println!("{}", scale.describe());
         }
         println!(
-            "wrote {} ({width}x{height}, {samples} spp, accel {}, {:.2} s on {} threads)",
+            "wrote {} ({width}x{height}, {samples} spp, {}, accel {}, {:.2} s on {} threads)",
             output.display(),
+            integrator.name(),
             args.accel,
             out.seconds,
             pool.current_num_threads()

@@ -1,7 +1,8 @@
 //! # englobe-render
 //!
 //! englobe's renderer: a pinhole camera, point and directional lights, Phong-style materials with
-//! mirrors and glass, the Whitted integrator of the seed report, tiled parallel rendering that
+//! mirrors and glass, the Whitted integrator of the seed report and a Monte Carlo path tracer,
+//! tiled parallel rendering that
 //! gives the same bytes on any number of threads, atomic PNG/EXR output, and the cost AOV: a
 //! false-colour picture of the work an acceleration structure does per pixel.
 //!
@@ -16,11 +17,15 @@
 
 pub mod camera;
 pub mod cost;
+pub mod emitters;
 pub mod film;
 pub mod heatmap;
 pub mod optics;
 pub mod output;
+pub mod path;
 pub mod render;
+pub mod sampling;
+pub mod shading;
 pub mod stats;
 pub mod whitted;
 
@@ -29,6 +34,7 @@ pub use cost::{CostImage, write_cost_image};
 pub use film::Film;
 pub use heatmap::{Heatmap, HeatmapScale};
 pub use output::{OutputError, OutputFormat, write_image};
+pub use path::PathTracer;
 pub use render::{RenderError, RenderOutput, Renderer};
 pub use stats::{KindStats, RayKind, RenderStats};
 

@@ -12,7 +12,7 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::time::Instant;
 
 use englobe::{Counters, NoCount, Vec3, WorkCounts, World};
-use englobe_scene::{ImageSettings, Scene};
+use englobe_scene::{ImageSettings, IntegratorKind, Scene};
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg32;
 use rayon::prelude::*;
@@ -20,6 +20,7 @@ use rayon::prelude::*;
 use crate::camera::PinholeCamera;
 use crate::cost::CostImage;
 use crate::film::Film;
+use crate::path::PathTracer;
 use crate::stats::{RayKind, RenderStats, Tally};
 use crate::whitted::Whitted;
 
@@ -61,6 +62,7 @@ pub struct Renderer<'a> {
     stride: u32,
     progress: Option<&'a (dyn Fn(usize, usize) + Sync)>,
     cancel: Option<&'a AtomicBool>,
+    integrator: IntegratorKind,
 }
 
 impl<'a> Renderer<'a> {
@@ -79,6 +81,7 @@ impl<'a> Renderer<'a> {
             stride: 1,
             progress: None,
             cancel: None,
+            integrator: scene.image.integrator,
         }
     }
 
@@ -117,6 +120,12 @@ impl<'a> Renderer<'a> {
         self
     }
 
+    /// Overrides the scene's integrator.
+    pub fn integrator(mut self, kind: IntegratorKind) -> Self {
+        self.integrator = kind;
+        self
+    }
+
     /// Calls `f(tiles_done, tiles_total)` after every tile, from any worker thread.
     pub fn on_progress(mut self, f: &'a (dyn Fn(usize, usize) + Sync)) -> Self {
         self.progress = Some(f);
@@ -144,7 +153,10 @@ impl<'a> Renderer<'a> {
     fn render_with<C: Counters + Copy + Send + Into<WorkCounts>>(&self) -> RenderOutput {
         let start = Instant::now();
         let camera = PinholeCamera::new(&self.scene.camera, self.width, self.height);
-        let integrator = Whitted::new(self.scene, self.world);
+        let integrator = match self.integrator {
+            IntegratorKind::Whitted => Integrator::Whitted(Whitted::new(self.scene, self.world)),
+            IntegratorKind::Path => Integrator::Path(PathTracer::new(self.scene, self.world)),
+        };
         let tiles_x = self.width.div_ceil(TILE_SIZE);
         let tiles_y = self.height.div_ceil(TILE_SIZE);
         let total = (tiles_x * tiles_y) as usize;
@@ -219,24 +231,36 @@ impl<'a> Renderer<'a> {
     fn pixel<C: Counters>(
         &self,
         camera: &PinholeCamera,
-        integrator: &Whitted,
+        integrator: &Integrator,
         x: u32,
         y: u32,
         tally: &mut Tally<C>,
     ) -> Vec3 {
-        if self.samples == 1 {
-            let ray = camera.ray(x as f32 + 0.5, y as f32 + 0.5);
-            return integrator.radiance(&ray, RayKind::Primary, 0, tally);
-        }
         let mut rng = pixel_rng(self.scene.image.seed, x, y);
+        let mut sample = |rng: &mut Pcg32, dx: f32, dy: f32| {
+            let ray = camera.ray(x as f32 + dx, y as f32 + dy);
+            match integrator {
+                Integrator::Whitted(w) => w.radiance(&ray, RayKind::Primary, 0, tally),
+                Integrator::Path(p) => p.radiance(&ray, rng, tally),
+            }
+        };
+        if self.samples == 1 {
+            // One sample goes through the pixel's centre, as the seed's renderer did.
+            return sample(&mut rng, 0.5, 0.5);
+        }
         let mut sum = Vec3::ZERO;
         for _ in 0..self.samples {
             let (dx, dy): (f32, f32) = (rng.random(), rng.random());
-            let ray = camera.ray(x as f32 + dx, y as f32 + dy);
-            sum += integrator.radiance(&ray, RayKind::Primary, 0, tally);
+            sum += sample(&mut rng, dx, dy);
         }
         sum / self.samples as f32
     }
+}
+
+/// The integrator a render uses.
+enum Integrator<'a> {
+    Whitted(Whitted<'a>),
+    Path(PathTracer<'a>),
 }
 
 /// What one tile produced: its pixels row by row, its counts, and its pixels' work if recorded.

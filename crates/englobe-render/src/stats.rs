@@ -4,7 +4,7 @@
 use englobe::{Counters, WorkCounts};
 use serde::Serialize;
 
-/// The kinds of rays a Whitted integrator casts.
+/// The kinds of rays the integrators cast.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum RayKind {
@@ -16,11 +16,17 @@ pub enum RayKind {
     Reflected,
     /// Transmission through transparent surfaces.
     Refracted,
+    /// Diffuse bounces of the path tracer (random directions over the hemisphere).
+    Bounce,
 }
 
 impl RayKind {
+    /// Number of kinds.
+    pub const COUNT: usize = 5;
+
     /// Every kind, in table order.
-    pub const ALL: [RayKind; 4] = [RayKind::Primary, RayKind::Shadow, RayKind::Reflected, RayKind::Refracted];
+    pub const ALL: [RayKind; RayKind::COUNT] =
+        [RayKind::Primary, RayKind::Shadow, RayKind::Reflected, RayKind::Refracted, RayKind::Bounce];
 
     /// Lower-case name.
     pub fn name(self) -> &'static str {
@@ -29,6 +35,7 @@ impl RayKind {
             RayKind::Shadow => "shadow",
             RayKind::Reflected => "reflected",
             RayKind::Refracted => "refracted",
+            RayKind::Bounce => "bounce",
         }
     }
 }
@@ -59,7 +66,7 @@ impl KindStats {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct RenderStats {
     /// Indexed by `RayKind as usize`.
-    pub kinds: [KindStats; 4],
+    pub kinds: [KindStats; RayKind::COUNT],
 }
 
 impl RenderStats {
@@ -88,9 +95,9 @@ impl RenderStats {
 #[derive(Debug, Default)]
 pub struct Tally<C: Counters> {
     /// Rays cast, by kind.
-    pub rays: [u64; 4],
+    pub rays: [u64; RayKind::COUNT],
     /// Work, by kind.
-    pub work: [C; 4],
+    pub work: [C; RayKind::COUNT],
 }
 
 impl<C: Counters + Into<WorkCounts> + Copy> Tally<C> {

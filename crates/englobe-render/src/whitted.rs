@@ -9,14 +9,12 @@
 //! (1 under total internal reflection). A material with `kt = 1`, index 1 and no highlight is thus
 //! exactly invisible: its colour is `T`, and `T` is the colour behind it.
 
-use englobe::{Counters, Ray, Vec3, World, WorldHit};
-use englobe_scene::{Light, Material, Scene};
+use englobe::{Counters, Ray, Vec3, World};
+use englobe_scene::Scene;
 
-use crate::optics::{fresnel_dielectric, offset_ray_origin, reflect, refract};
+use crate::optics::{fresnel_dielectric, reflect, refract};
+use crate::shading::Surface;
 use crate::stats::{RayKind, Tally};
-
-/// Shadow rays toward a point light stop this fraction short of it.
-const SHADOW_RAY_END: f32 = 1.0 - 1e-4;
 
 /// The Whitted integrator over a scene and its world (built from the scene's objects, in order).
 pub struct Whitted<'a> {
@@ -30,56 +28,17 @@ impl<'a> Whitted<'a> {
         Whitted { scene, world }
     }
 
-    /// The material at a hit: the object's, or its triangle's when the mesh gives one per triangle.
-    fn material(&self, hit: &WorldHit) -> &Material {
-        let id = self.scene.objects[hit.object as usize].material_of(hit.prim);
-        &self.scene.materials[id as usize]
-    }
-
     /// The colour seen along `ray`, a ray of `kind` at recursion `depth` (0 for primary rays).
     pub fn radiance<C: Counters>(&self, ray: &Ray, kind: RayKind, depth: u32, tally: &mut Tally<C>) -> Vec3 {
         tally.rays[kind as usize] += 1;
         let Some(hit) = self.world.closest_hit(ray, &mut tally.work[kind as usize]) else {
             return self.scene.image.background;
         };
-        let m = self.material(&hit);
-        let p = self.world.hit_point(ray, &hit);
-        let d = ray.dir().normalize();
-        let geometric = self.world.geometric_normal(&hit, p);
-        let entering = d.dot(geometric) < 0.0;
-        // Normals facing the side the ray came from.
-        let n = if entering { geometric } else { -geometric };
-        let shading = self.world.shading_normal(&hit, p);
-        let ns = if shading.dot(n) < 0.0 { -shading } else { shading };
-
+        let s = Surface::at(self.scene, self.world, ray, &hit);
+        let m = s.material;
         let (kr, kt) = (m.reflectivity, m.transparency);
-        let mut diffuse = self.scene.image.ambient * m.diffuse;
-        let mut highlight = Vec3::ZERO;
-        let lit_side = offset_ray_origin(p, n);
-        for light in &self.scene.lights {
-            let (shadow_ray, to_light, radiance) = match *light {
-                Light::Point { position, power } => {
-                    // Shading uses the true point; only the shadow ray starts off the surface.
-                    let v = position - p;
-                    let dist2 = v.length_squared();
-                    let shadow = Ray::segment(lit_side, position - lit_side, 0.0, SHADOW_RAY_END);
-                    (shadow, v / dist2.sqrt(), power / dist2)
-                }
-                Light::Directional { direction, radiance } => (Ray::new(lit_side, -direction), -direction, radiance),
-            };
-            if to_light.dot(n) <= 0.0 || !to_light.is_finite() {
-                continue; // the light is behind the surface
-            }
-            tally.rays[RayKind::Shadow as usize] += 1;
-            if self.world.any_hit(&shadow_ray, &mut tally.work[RayKind::Shadow as usize]) {
-                continue;
-            }
-            diffuse += m.diffuse * ns.dot(to_light).max(0.0) * radiance;
-            if m.specular != Vec3::ZERO {
-                let half = (to_light - d).normalize_or_zero();
-                highlight += m.specular * ns.dot(half).max(0.0).powf(m.shininess) * radiance;
-            }
-        }
+        let (lit, highlight) = s.direct_light(self.scene, self.world, tally);
+        let diffuse = self.scene.image.ambient * m.diffuse + lit;
         let mut color = m.emission + diffuse * (1.0 - kr - kt) + highlight;
 
         if depth >= self.scene.image.max_depth {
@@ -87,20 +46,20 @@ impl<'a> Whitted<'a> {
         }
         let mut mirror_weight = kr;
         if kt > 0.0 {
-            let eta = if entering { 1.0 / m.ior } else { m.ior };
-            match refract(d, n, eta) {
+            let eta = if s.entering { 1.0 / m.ior } else { m.ior };
+            match refract(s.d, s.n, eta) {
                 None => mirror_weight += kt, // total internal reflection
                 Some((t_dir, cos_t)) => {
-                    let cos_i = -d.dot(n);
+                    let cos_i = -s.d.dot(s.n);
                     let f = fresnel_dielectric(cos_i, cos_t, eta);
                     mirror_weight += kt * f;
-                    let refracted = Ray::new(offset_ray_origin(p, -n), t_dir);
+                    let refracted = Ray::new(s.inside(), t_dir);
                     color += self.radiance(&refracted, RayKind::Refracted, depth + 1, tally) * (kt * (1.0 - f));
                 }
             }
         }
         if mirror_weight > 0.0 {
-            let reflected = Ray::new(lit_side, reflect(d, n));
+            let reflected = Ray::new(s.outside(), reflect(s.d, s.n));
             color += self.radiance(&reflected, RayKind::Reflected, depth + 1, tally) * mirror_weight;
         }
         color

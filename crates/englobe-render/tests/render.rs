@@ -22,9 +22,10 @@ fn default_scene_renders_with_every_kind_of_ray() {
     let world = build_world(&s, AccelKind::None).unwrap();
     let out = Renderer::new(&s, &world).size(80, 60).count_work(true).render().unwrap();
     assert!(out.complete);
-    for kind in RayKind::ALL {
+    for kind in [RayKind::Primary, RayKind::Shadow, RayKind::Reflected, RayKind::Refracted] {
         assert!(out.stats.kind(kind).rays > 0, "no {} rays", kind.name());
     }
+    assert_eq!(out.stats.kind(RayKind::Bounce).rays, 0, "Whitted's recursion never bounces diffusely");
     assert_eq!(out.stats.kind(RayKind::Primary).rays, 80 * 60 * s.image.samples as u64);
     // Brute force tests each of the 6 objects once per closest-hit ray.
     let primary = out.stats.kind(RayKind::Primary);

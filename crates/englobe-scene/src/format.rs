@@ -55,6 +55,8 @@ pub struct ImageDef {
     pub ambient: Option<Color>,
     #[serde(default)]
     pub seed: u64,
+    #[serde(default)]
+    pub integrator: crate::model::IntegratorKind,
 }
 
 #[derive(Debug, Deserialize)]

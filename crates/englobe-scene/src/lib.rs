@@ -16,7 +16,8 @@ pub mod shared_data;
 
 pub use error::{Located, SceneError};
 pub use model::{
-    Camera, ImageSettings, Light, MAX_DEPTH, MAX_PIXELS, MAX_SAMPLES, Material, MaterialId, Scene, SceneObject,
+    Camera, ImageSettings, IntegratorKind, Light, MAX_DEPTH, MAX_PIXELS, MAX_SAMPLES, Material, MaterialId, Scene,
+    SceneObject,
 };
 pub use parse::{DEFAULT_MATERIAL, load_scene, parse_scene};
 pub use parse_mesh::MAX_MESH_INSTANCES;

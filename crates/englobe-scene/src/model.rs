@@ -30,6 +30,29 @@ pub struct ImageSettings {
     pub ambient: Vec3,
     /// Seed of the pixel sampler; the same seed gives the same image.
     pub seed: u64,
+    /// How light is computed.
+    pub integrator: IntegratorKind,
+}
+
+/// The light transport algorithm.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Deserialize, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum IntegratorKind {
+    /// Whitted's recursion (the seed's): shadow rays, mirror and refraction rays, an ambient term.
+    #[default]
+    Whitted,
+    /// Monte Carlo path tracing: diffuse inter-reflection and emissive surfaces as lights.
+    Path,
+}
+
+impl IntegratorKind {
+    /// The name used in scene files and on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            IntegratorKind::Whitted => "whitted",
+            IntegratorKind::Path => "path",
+        }
+    }
 }
 
 impl ImageSettings {

@@ -165,6 +165,7 @@ impl Converter<'_> {
             background: i.background.map_or(Vec3::ZERO, |c| c.0),
             ambient: i.ambient.map_or(Vec3::ZERO, |c| c.0),
             seed: i.seed,
+            integrator: i.integrator,
         })
     }
 

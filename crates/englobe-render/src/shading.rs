@@ -1,0 +1,93 @@
+//! What both integrators need at a hit: the surface frame (point, normals facing the incoming
+//! ray, material) and the light arriving from each point or directional light, with the shadow
+//! ray that decides whether it arrives.
+//!
+//! Light units follow the Whitted convention of the scene format: a white diffuse surface facing
+//! a point light of intensity `I` at distance `d` reflects `I / d²`, so a diffuse surface's
+//! response to a light is `diffuse * cos θ * radiance`, with no `1 / π` (the path tracer uses the
+//! same response, which amounts to reading the scene's intensities as `π` times a radiant intensity).
+
+use englobe::{Counters, Ray, Vec3, World, WorldHit};
+use englobe_scene::{Light, Material, Scene};
+
+use crate::optics::offset_ray_origin;
+use crate::stats::{RayKind, Tally};
+
+/// Shadow rays toward a point light stop this fraction short of it.
+pub(crate) const SHADOW_RAY_END: f32 = 1.0 - 1e-4;
+
+/// A hit, ready for shading.
+pub struct Surface<'a> {
+    /// The hit point (moved back onto the surface where the shape allows).
+    pub p: Vec3,
+    /// The unit direction the ray travelled in.
+    pub d: Vec3,
+    /// Geometric normal, facing the side the ray came from.
+    pub n: Vec3,
+    /// Shading normal (interpolated for smooth meshes), on the same side as `n`.
+    pub ns: Vec3,
+    /// True if the ray arrived on the outer side of the surface (against its outward normal).
+    pub entering: bool,
+    /// The material.
+    pub material: &'a Material,
+}
+
+impl<'a> Surface<'a> {
+    /// The surface at `hit` of `ray`.
+    pub fn at(scene: &'a Scene, world: &World, ray: &Ray, hit: &WorldHit) -> Self {
+        let id = scene.objects[hit.object as usize].material_of(hit.prim);
+        let material = &scene.materials[id as usize];
+        let p = world.hit_point(ray, hit);
+        let d = ray.dir().normalize();
+        let geometric = world.geometric_normal(hit, p);
+        let entering = d.dot(geometric) < 0.0;
+        let n = if entering { geometric } else { -geometric };
+        let shading = world.shading_normal(hit, p);
+        let ns = if shading.dot(n) < 0.0 { -shading } else { shading };
+        Surface { p, d, n, ns, entering, material }
+    }
+
+    /// The origin of rays leaving on the side the ray came from.
+    pub fn outside(&self) -> Vec3 {
+        offset_ray_origin(self.p, self.n)
+    }
+
+    /// The origin of rays leaving through the surface.
+    pub fn inside(&self) -> Vec3 {
+        offset_ray_origin(self.p, -self.n)
+    }
+
+    /// The diffuse and highlight light arriving from every light that the point sees, one
+    /// shadow ray per light in front of the surface. Returns `(diffuse, highlight)`, the first
+    /// to be weighted by the surface's diffuse share.
+    pub fn direct_light<C: Counters>(&self, scene: &Scene, world: &World, tally: &mut Tally<C>) -> (Vec3, Vec3) {
+        let m = self.material;
+        let origin = self.outside();
+        let (mut diffuse, mut highlight) = (Vec3::ZERO, Vec3::ZERO);
+        for light in &scene.lights {
+            let (shadow_ray, to_light, radiance) = match *light {
+                Light::Point { position, power } => {
+                    // Shading uses the true point; only the shadow ray starts off the surface.
+                    let v = position - self.p;
+                    let dist2 = v.length_squared();
+                    let shadow = Ray::segment(origin, position - origin, 0.0, SHADOW_RAY_END);
+                    (shadow, v / dist2.sqrt(), power / dist2)
+                }
+                Light::Directional { direction, radiance } => (Ray::new(origin, -direction), -direction, radiance),
+            };
+            if to_light.dot(self.n) <= 0.0 || !to_light.is_finite() {
+                continue; // the light is behind the surface
+            }
+            tally.rays[RayKind::Shadow as usize] += 1;
+            if world.any_hit(&shadow_ray, &mut tally.work[RayKind::Shadow as usize]) {
+                continue;
+            }
+            diffuse += m.diffuse * self.ns.dot(to_light).max(0.0) * radiance;
+            if m.specular != Vec3::ZERO {
+                let half = (to_light - self.d).normalize_or_zero();
+                highlight += m.specular * self.ns.dot(half).max(0.0).powf(m.shininess) * radiance;
+            }
+        }
+        (diffuse, highlight)
+    }
+}
