@@ -72,11 +72,17 @@ impl Ray {
     }
 
     /// A ray can hit something only if its origin and direction are finite, its direction is not
-    /// zero and its interval is not empty (NaN bounds make it empty). Structures answer "no hit"
-    /// for any other ray without traversing anything.
+    /// zero and its interval holds a finite parameter (NaN bounds make it empty, and so do
+    /// `inf..=inf` and `-inf..=-inf`). Structures answer "no hit" for any other ray without
+    /// traversing anything.
     #[inline]
     pub fn is_valid(&self) -> bool {
-        self.origin.is_finite() && self.dir.is_finite() && self.dir != Vec3::ZERO && self.t_min <= self.t_max
+        self.origin.is_finite()
+            && self.dir.is_finite()
+            && self.dir != Vec3::ZERO
+            && self.t_min <= self.t_max
+            && self.t_min < f32::INFINITY
+            && self.t_max > f32::NEG_INFINITY
     }
 }
 
@@ -109,5 +115,8 @@ mod tests {
         assert!(!Ray::segment(Vec3::ZERO, Vec3::X, f32::NAN, 1.0).is_valid());
         assert!(!Ray::segment(Vec3::ZERO, Vec3::X, 2.0, 1.0).is_valid());
         assert!(Ray::segment(Vec3::ZERO, Vec3::X, 1.0, 1.0).is_valid());
+        assert!(Ray::segment(Vec3::ZERO, Vec3::X, f32::NEG_INFINITY, f32::INFINITY).is_valid());
+        assert!(!Ray::segment(Vec3::ZERO, Vec3::X, f32::INFINITY, f32::INFINITY).is_valid());
+        assert!(!Ray::segment(Vec3::ZERO, Vec3::X, f32::NEG_INFINITY, f32::NEG_INFINITY).is_valid());
     }
 }

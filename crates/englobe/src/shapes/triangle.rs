@@ -4,11 +4,12 @@
 //! The vertices are moved into a frame where the ray runs along +z from the origin; the test then
 //! reduces to 2D edge functions evaluated with the same operations, in the same order, for the two
 //! triangles that share an edge, so a ray through a shared edge or vertex can never slip between
-//! them. Edge functions that come out exactly zero are recomputed in `f64`, as the paper
-//! prescribes, so that the sign decision on an edge is exact. A zero-area triangle has a zero
-//! determinant and is never hit.
+//! them. When an edge function comes out exactly zero the paper recomputes it in `f64` so that the
+//! sign decision on an edge is exact; we finish the whole test in `f64` then, and also when an edge
+//! function underflows or overflows `f32` (scenes scaled far below or above 1), so that the answer
+//! does not depend on the scene's scale. A zero-area triangle has a zero determinant and is never hit.
 
-use glam::{DVec2, Vec3};
+use glam::Vec3;
 
 use super::{Bounded, Intersect, PrimHit};
 use crate::{Aabb, Ray};
@@ -81,34 +82,88 @@ pub fn intersect_triangle(ray: &Ray, w: &WatertightRay, v0: Vec3, v1: Vec3, v2: 
     let cx = c[w.kx] - sx * c[w.kz];
     let cy = c[w.ky] - sy * c[w.kz];
 
-    let mut e0 = cx * by - cy * bx;
-    let mut e1 = ax * cy - ay * cx;
-    let mut e2 = bx * ay - by * ax;
-    if e0 == 0.0 || e1 == 0.0 || e2 == 0.0 {
-        let edge = |p: DVec2, q: DVec2| (p.x * q.y - p.y * q.x) as f32;
-        let (a2, b2, c2) =
-            (DVec2::new(ax as f64, ay as f64), DVec2::new(bx as f64, by as f64), DVec2::new(cx as f64, cy as f64));
-        e0 = edge(c2, b2);
-        e1 = edge(a2, c2);
-        e2 = edge(b2, a2);
+    let az = sz * a[w.kz];
+    let bz = sz * b[w.kz];
+    let cz = sz * c[w.kz];
+    let projected = Projected { ax, ay, az, bx, by, bz, cx, cy, cz };
+
+    let e0 = cx * by - cy * bx;
+    let e1 = ax * cy - ay * cx;
+    let e2 = bx * ay - by * ax;
+    // An edge function that is exactly zero (a ray through an edge or vertex) is where rounding
+    // could let a ray slip between two triangles: the paper recomputes it in double precision
+    // from the same projected vertices. We do the rest of the test in double precision too, and
+    // also when an edge function underflowed (subnormal) or overflowed, so that scenes at any
+    // scale `f32` can hold give the same answers. Rounding is monotonic, so an `f32` edge
+    // function is either zero or of the right sign, and the triangle on the other side of a
+    // shared edge sees the same value: the two triangles never disagree.
+    if !(e0.is_normal() && e1.is_normal() && e2.is_normal()) {
+        return projected.intersect_f64(ray);
     }
     if (e0 < 0.0 || e1 < 0.0 || e2 < 0.0) && (e0 > 0.0 || e1 > 0.0 || e2 > 0.0) {
         return None;
     }
     let det = e0 + e1 + e2;
-    if det == 0.0 || !det.is_finite() {
-        return None;
-    }
-    let az = sz * a[w.kz];
-    let bz = sz * b[w.kz];
-    let cz = sz * c[w.kz];
     let t_scaled = e0 * az + e1 * bz + e2 * cz;
     let inv_det = 1.0 / det;
     let t = t_scaled * inv_det;
+    if !t.is_finite() {
+        return projected.intersect_f64(ray);
+    }
     if !(t >= ray.t_min && t <= ray.t_max) {
         return None;
     }
     Some(PrimHit { t, u: e1 * inv_det, v: e2 * inv_det })
+}
+
+/// The three vertices in the ray's sheared frame, as the single-precision test computed them.
+struct Projected {
+    ax: f32,
+    ay: f32,
+    az: f32,
+    bx: f32,
+    by: f32,
+    bz: f32,
+    cx: f32,
+    cy: f32,
+    cz: f32,
+}
+
+impl Projected {
+    /// The rest of the test in `f64`: the products of two `f32` values are exact there, so edge
+    /// functions have the right sign, and neither underflow nor overflow for any `f32` scene. A
+    /// zero-area triangle still has a zero determinant and is never hit.
+    #[cold]
+    #[inline(never)]
+    fn intersect_f64(&self, ray: &Ray) -> Option<PrimHit> {
+        let f = |x: f32| x as f64;
+        let (ax, ay, az, bx, by, bz, cx, cy, cz) = (
+            f(self.ax),
+            f(self.ay),
+            f(self.az),
+            f(self.bx),
+            f(self.by),
+            f(self.bz),
+            f(self.cx),
+            f(self.cy),
+            f(self.cz),
+        );
+        let e0 = cx * by - cy * bx;
+        let e1 = ax * cy - ay * cx;
+        let e2 = bx * ay - by * ax;
+        if (e0 < 0.0 || e1 < 0.0 || e2 < 0.0) && (e0 > 0.0 || e1 > 0.0 || e2 > 0.0) {
+            return None;
+        }
+        let det = e0 + e1 + e2;
+        if det == 0.0 || !det.is_finite() {
+            return None;
+        }
+        let t = ((e0 * az + e1 * bz + e2 * cz) / det) as f32;
+        if !(t >= ray.t_min && t <= ray.t_max && t.is_finite()) {
+            return None;
+        }
+        Some(PrimHit { t, u: (e1 / det) as f32, v: (e2 / det) as f32 })
+    }
 }
 
 impl Bounded for Triangle {
