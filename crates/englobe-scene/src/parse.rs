@@ -131,7 +131,7 @@ impl Converter<'_> {
             let span = t.span();
             let t = t.into_inner();
             let tri = Triangle::new(t.vertices[0].0, t.vertices[1].0, t.vertices[2].0);
-            if tri.double_area() <= 0.0 || tri.double_area().is_nan() {
+            if tri.is_degenerate() {
                 return Err(
                     self.err(span, "a triangle needs three vertices that are not on one line (its area is zero)")
                 );

@@ -95,17 +95,16 @@ pub(super) fn finish(
     Ok(LoadedMesh { mesh, materials, triangle_materials: parts.triangle_materials, warnings, format })
 }
 
-/// Removes the triangles of zero area (two equal indices, or three points on one line, decided in
-/// `f64` where the cross product of `f32` differences is exact up to one rounding), and their
-/// materials. Returns how many were removed.
+/// Removes the triangles of zero area (two equal indices, or three points on one line as
+/// [`englobe::shapes::is_degenerate`] decides it), and their materials. Returns how many were removed.
 pub(super) fn drop_degenerate(
     positions: &[Vec3],
     triangles: &mut Vec<[u32; 3]>,
     materials: Option<&mut Vec<u32>>,
 ) -> usize {
     let degenerate = |t: &[u32; 3]| {
-        let [a, b, c] = t.map(|i| positions[i as usize].as_dvec3());
-        t[0] == t[1] || t[1] == t[2] || t[0] == t[2] || (b - a).cross(c - a) == glam::DVec3::ZERO
+        let [a, b, c] = t.map(|i| positions[i as usize]);
+        t[0] == t[1] || t[1] == t[2] || t[0] == t[2] || englobe::shapes::is_degenerate(a, b, c)
     };
     let before = triangles.len();
     match materials {

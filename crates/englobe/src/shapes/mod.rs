@@ -14,7 +14,7 @@ pub use instance::{Instance, InstanceError, transform_box};
 pub use mesh::{MeshError, TriangleMesh};
 pub use plane::Plane;
 pub use sphere::Sphere;
-pub use triangle::{Triangle, WatertightRay, intersect_triangle};
+pub use triangle::{Triangle, WatertightRay, intersect_triangle, is_degenerate};
 
 use glam::Vec3;
 

@@ -27,10 +27,17 @@ impl Triangle {
         Triangle { vertices: [a, b, c] }
     }
 
-    /// Twice the area: zero for degenerate triangles.
+    /// Twice the area (in `f32`, so it can underflow for tiny triangles: use
+    /// [`Triangle::is_degenerate`] to ask whether there is any area at all).
     pub fn double_area(&self) -> f32 {
         let [a, b, c] = self.vertices;
         (b - a).cross(c - a).length()
+    }
+
+    /// True if the vertices lie on one line (see [`is_degenerate`]): such a triangle is never hit.
+    pub fn is_degenerate(&self) -> bool {
+        let [a, b, c] = self.vertices;
+        is_degenerate(a, b, c)
     }
 }
 
@@ -98,7 +105,7 @@ pub fn intersect_triangle(ray: &Ray, w: &WatertightRay, v0: Vec3, v1: Vec3, v2: 
     // function is either zero or of the right sign, and the triangle on the other side of a
     // shared edge sees the same value: the two triangles never disagree.
     if !(e0.is_normal() && e1.is_normal() && e2.is_normal()) {
-        return projected.intersect_f64(ray);
+        return projected.intersect_f64(ray).filter(|_| !is_degenerate(v0, v1, v2));
     }
     if (e0 < 0.0 || e1 < 0.0 || e2 < 0.0) && (e0 > 0.0 || e1 > 0.0 || e2 > 0.0) {
         return None;
@@ -108,12 +115,23 @@ pub fn intersect_triangle(ray: &Ray, w: &WatertightRay, v0: Vec3, v1: Vec3, v2: 
     let inv_det = 1.0 / det;
     let t = t_scaled * inv_det;
     if !t.is_finite() {
-        return projected.intersect_f64(ray);
+        return projected.intersect_f64(ray).filter(|_| !is_degenerate(v0, v1, v2));
     }
-    if !(t >= ray.t_min && t <= ray.t_max) {
+    if !(t >= ray.t_min && t <= ray.t_max) || is_degenerate(v0, v1, v2) {
         return None;
     }
     Some(PrimHit { t, u: e1 * inv_det, v: e2 * inv_det })
+}
+
+/// True if the triangle has no area: its three vertices lie exactly on one line (or coincide).
+/// Decided in `f64`, where the differences of `f32` coordinates are exact and the cross product
+/// rounds once, so the answer does not depend on the triangle's scale. The mesh loaders drop
+/// triangles by this rule; the intersection test applies it on its (rare) hit path, because the
+/// shear can round the projected vertices of such a triangle off their common line.
+#[inline]
+pub fn is_degenerate(v0: Vec3, v1: Vec3, v2: Vec3) -> bool {
+    let (a, b, c) = (v0.as_dvec3(), v1.as_dvec3(), v2.as_dvec3());
+    (b - a).cross(c - a) == glam::DVec3::ZERO
 }
 
 /// The three vertices in the ray's sheared frame, as the single-precision test computed them.
@@ -247,6 +265,45 @@ mod tests {
             assert!(point.intersect(&ray).is_none());
         }
         assert_eq!(flat.double_area(), 0.0);
+        assert!(flat.is_degenerate() && point.is_degenerate() && !tri().is_degenerate());
+    }
+
+    #[test]
+    fn needles_and_slivers_never_give_nan() {
+        // Triangles whose vertices nearly coincide or nearly line up, hit from many directions:
+        // any hit has finite t and barycentrics in [0, 1]; exactly collinear ones are never hit.
+        let needles = [
+            Triangle::new(Vec3::ZERO, Vec3::new(1.0, 1e-7, 0.0), Vec3::new(2.0, 0.0, 0.0)),
+            Triangle::new(Vec3::ZERO, Vec3::new(1e-30, 0.0, 0.0), Vec3::new(0.0, 1.0, 0.0)),
+            Triangle::new(Vec3::ONE, Vec3::ONE + Vec3::splat(1e-38), Vec3::ONE * 2.0),
+            Triangle::new(Vec3::new(1e6, 0.0, 0.0), Vec3::new(1e6 + 0.0625, 0.0, 0.0), Vec3::new(1e6, 1e-3, 1e-3)),
+        ];
+        let collinear = Triangle::new(Vec3::ZERO, Vec3::new(1.0, 1.0, 1.0), Vec3::new(3.0, 3.0, 3.0));
+        for i in 0..2000 {
+            let a = i as f32 * 0.618_034;
+            let o = Vec3::new(a.sin() * 3.0, (a * 1.3).cos() * 3.0, (a * 0.7).sin() * 3.0 + 0.5);
+            for tri in needles.iter().chain([&collinear]) {
+                let target = tri.vertices[i % 3] * 0.5 + tri.vertices[(i + 1) % 3] * 0.5;
+                let ray = Ray::new(o, target - o);
+                if let Some(hit) = tri.intersect(&ray) {
+                    assert!(hit.t.is_finite() && hit.u.is_finite() && hit.v.is_finite(), "{tri:?}: {hit:?}");
+                    assert!((0.0..=1.0).contains(&hit.u) && (0.0..=1.0).contains(&hit.v), "{tri:?}: {hit:?}");
+                }
+            }
+            assert!(collinear.intersect(&Ray::new(o, collinear.vertices[1] - o)).is_none());
+        }
+    }
+
+    #[test]
+    fn scaled_far_up_or_down_a_triangle_is_hit_the_same() {
+        for s in [1e-30f32, 1e-20, 1e-10, 1.0, 1e10, 1e20, 1e30] {
+            let t =
+                Triangle::new(Vec3::new(0.0, 0.0, 1.0) * s, Vec3::new(1.0, 0.0, 1.0) * s, Vec3::new(0.0, 1.0, 1.0) * s);
+            let hit = t.intersect(&Ray::new(Vec3::new(0.25, 0.5, -1.0) * s, Vec3::Z)).expect("hit at every scale");
+            assert!((hit.t / s - 2.0).abs() < 1e-6, "scale {s:e}: t = {}", hit.t);
+            assert!((hit.u - 0.25).abs() < 1e-6 && (hit.v - 0.5).abs() < 1e-6);
+            assert!(t.intersect(&Ray::new(Vec3::new(0.75, 0.5, -1.0) * s, Vec3::Z)).is_none(), "scale {s:e}");
+        }
     }
 
     #[test]
