@@ -142,6 +142,10 @@ fn bad_arguments_and_files_are_refused() {
     refused(&["render", "--width", "0"], "at least 1");
     refused(&["render", "--width", "100000", "--height", "100000"], "more than the limit");
     refused(&["render", "--spp", "0"], "samples per pixel");
+    refused(&["render", "--spp", "100000000"], "samples per pixel");
+    refused(&["render", "--width", "4294967296"], "--width");
+    refused(&["render", "--width", "65536", "--height", "65536"], "more than the limit");
+    refused(&["render", "--height=-3"], "--height");
     refused(&["render", "--threads", "0"], "--threads");
     refused(&["render", "missing.toml"], "missing.toml: cannot read");
     refused(&["render", "."], "is a directory");
@@ -203,4 +207,47 @@ fn ctrl_c_stops_with_code_130_and_writes_nothing() {
     assert_eq!(std::fs::read(dir.path().join("keep.png")).unwrap(), b"a good image");
     let leftovers: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
     assert_eq!(leftovers.len(), 1, "no temporary file is left behind");
+}
+
+#[cfg(unix)]
+#[test]
+fn an_unreadable_scene_file_is_named_in_the_error() {
+    let dir = tempfile::tempdir().unwrap();
+    std::os::unix::fs::symlink("loop.toml", dir.path().join("loop.toml")).unwrap();
+    let out = englobe(dir.path(), &["render", "loop.toml"]);
+    assert!(!out.status.success());
+    let err = stderr(&out);
+    assert!(err.contains("loop.toml: cannot read") && err.contains("symbolic links"), "{err}");
+}
+
+#[cfg(unix)]
+#[test]
+fn killing_a_render_at_any_moment_never_leaves_a_broken_image() {
+    use std::time::Instant;
+    let dir = tempfile::tempdir().unwrap();
+    // The good image already there: small, so that it can be told apart from the new one.
+    let first = englobe(dir.path(), &["render", "--width", "30", "--height", "20", "--spp", "1", "-o", "out.png"]);
+    assert!(first.status.success());
+    let args = ["render", "--width", "900", "--height", "700", "--spp", "1", "--quiet", "-o", "out.png"];
+    let start = Instant::now();
+    assert!(englobe(dir.path(), &args).status.success());
+    let full = start.elapsed();
+    let mut outcomes = std::collections::BTreeSet::new();
+    for k in 0..12u32 {
+        // Restore the small image, then kill a new render at a point spread over its life.
+        assert!(
+            englobe(dir.path(), &["render", "--width", "30", "--height", "20", "--spp", "1", "-o", "out.png"])
+                .status
+                .success()
+        );
+        let mut child = Command::new(env!("CARGO_BIN_EXE_englobe")).args(args).current_dir(dir.path()).spawn().unwrap();
+        std::thread::sleep(full * k / 10);
+        let _ = child.kill(); // SIGKILL: no handler runs
+        child.wait().unwrap();
+        let img = image::open(dir.path().join("out.png")).expect("out.png is always a complete image");
+        outcomes.insert((img.width(), img.height()));
+        assert!(matches!((img.width(), img.height()), (30, 20) | (900, 700)), "{}x{}", img.width(), img.height());
+    }
+    eprintln!("images seen after the kills: {outcomes:?}");
+    assert!(outcomes.contains(&(30, 20)), "some kills came before the new image was in place");
 }

@@ -90,6 +90,8 @@ fn wrong_types() {
     check("center = [0, 1, 0]", "center = [0, 1]", "[0, 1]", "expected an array of length 3");
     check("material = \"red\"", "material = 3", "3\n", "expected a string");
     check("width = 64", "width = -64", "-64", "expected u32");
+    check("width = 64", "width = 64\nmax_depth = -1", "-1", "expected u32");
+    check("width = 64", "width = 64\nsamples = 1e9", "1e9", "expected u32");
 }
 
 #[test]

@@ -104,7 +104,12 @@ fn missing_unreadable_and_broken_meshes_name_the_scene_line_and_the_file() {
     std::fs::create_dir(dir.path().join("folder.obj")).unwrap();
     std::fs::write(dir.path().join("broken.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n").unwrap();
     std::fs::write(dir.path().join("notes.txt"), "not a mesh\n").unwrap();
+    // Unreadable whoever runs the test (permissions do not stop root): a link to itself.
+    #[cfg(unix)]
+    std::os::unix::fs::symlink("loop.obj", dir.path().join("loop.obj")).unwrap();
     for (path, says) in [
+        #[cfg(unix)]
+        ("loop.obj", "symbolic links"),
         ("missing.obj", "No such file"),
         ("folder.obj", "directory"),
         ("tri.obj/inside.obj", "tri.obj/inside.obj"),
