@@ -106,6 +106,12 @@ pub fn load_mesh_file(path: &Path) -> Result<LoadedMesh, MeshFileError> {
         return Err(MeshFileError::file(path, kind));
     };
     let bytes = read_limited(path, MAX_MESH_FILE_BYTES)?;
+    load_mesh_bytes(path, format, bytes)
+}
+
+/// Reads and checks a mesh already in memory. `path` names it in errors, and files it refers to
+/// (an OBJ's material libraries, a glTF's buffers) are looked for beside it.
+pub fn load_mesh_bytes(path: &Path, format: MeshFormat, bytes: Vec<u8>) -> Result<LoadedMesh, MeshFileError> {
     match format {
         MeshFormat::Obj => obj::load(path, bytes),
         MeshFormat::Ply => ply::load(path, &bytes),
