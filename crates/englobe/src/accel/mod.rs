@@ -18,7 +18,7 @@ use std::fmt;
 use std::str::FromStr;
 
 pub use brute::BruteForce;
-pub use bvh::{Bvh, CandidateListBvh, SeedPairing};
+pub use bvh::{BinnedSah, Bvh, CandidateListBvh, Ploc, SeedPairing, SweepSah};
 pub use counters::{Counters, NoCount, WorkCounts};
 
 use crate::shapes::PrimHit;
@@ -126,11 +126,24 @@ pub enum AccelKind {
     BvhSeed,
     /// The seed report's BVH with the ordered traversal of [`Bvh`].
     BvhSeedOrdered,
+    /// A [`Bvh`] built top-down with the binned surface area heuristic ([`BinnedSah`]).
+    BvhSah,
+    /// A [`Bvh`] built bottom-up by parallel locally-ordered clustering ([`Ploc`]).
+    BvhPloc,
+    /// A [`Bvh`] built top-down with the full-sweep surface area heuristic ([`SweepSah`]).
+    BvhSweep,
 }
 
 impl AccelKind {
     /// Every structure, in the order tables list them.
-    pub const ALL: &'static [AccelKind] = &[AccelKind::None, AccelKind::BvhSeed, AccelKind::BvhSeedOrdered];
+    pub const ALL: &'static [AccelKind] = &[
+        AccelKind::None,
+        AccelKind::BvhSeed,
+        AccelKind::BvhSeedOrdered,
+        AccelKind::BvhSah,
+        AccelKind::BvhPloc,
+        AccelKind::BvhSweep,
+    ];
 
     /// The name used on the command line and in tables.
     pub fn name(self) -> &'static str {
@@ -138,6 +151,9 @@ impl AccelKind {
             AccelKind::None => "none",
             AccelKind::BvhSeed => "bvh-seed",
             AccelKind::BvhSeedOrdered => "bvh-seed-ordered",
+            AccelKind::BvhSah => "bvh-sah",
+            AccelKind::BvhPloc => "bvh-ploc",
+            AccelKind::BvhSweep => "bvh-sweep",
         }
     }
 
@@ -150,6 +166,13 @@ impl AccelKind {
             }
             AccelKind::BvhSeedOrdered => {
                 "the seed report's BVH, traversed nearer child first with t_max shrinking at each hit"
+            }
+            AccelKind::BvhSah => "binary BVH built top-down with the binned surface area heuristic (32 bins per axis)",
+            AccelKind::BvhPloc => {
+                "binary BVH built bottom-up by parallel locally-ordered clustering, leaves collapsed by the SAH"
+            }
+            AccelKind::BvhSweep => {
+                "binary BVH built top-down with the full-sweep surface area heuristic (the quality reference)"
             }
         }
     }
@@ -186,6 +209,12 @@ pub enum AnyAccel {
     BvhSeed(CandidateListBvh),
     /// See [`AccelKind::BvhSeedOrdered`].
     BvhSeedOrdered(Bvh),
+    /// See [`AccelKind::BvhSah`].
+    BvhSah(Bvh),
+    /// See [`AccelKind::BvhPloc`].
+    BvhPloc(Bvh),
+    /// See [`AccelKind::BvhSweep`].
+    BvhSweep(Bvh),
 }
 
 impl AnyAccel {
@@ -195,6 +224,9 @@ impl AnyAccel {
             AccelKind::None => AnyAccel::BruteForce(BruteForce::build(boxes)),
             AccelKind::BvhSeed => AnyAccel::BvhSeed(CandidateListBvh::build(boxes)),
             AccelKind::BvhSeedOrdered => AnyAccel::BvhSeedOrdered(SeedPairing::build(boxes)),
+            AccelKind::BvhSah => AnyAccel::BvhSah(BinnedSah::default().build(boxes)),
+            AccelKind::BvhPloc => AnyAccel::BvhPloc(Ploc::default().build(boxes)),
+            AccelKind::BvhSweep => AnyAccel::BvhSweep(SweepSah::default().build(boxes)),
         }
     }
 
@@ -203,7 +235,7 @@ impl AnyAccel {
         match self {
             AnyAccel::BruteForce(_) => None,
             AnyAccel::BvhSeed(a) => Some(a.bvh()),
-            AnyAccel::BvhSeedOrdered(a) => Some(a),
+            AnyAccel::BvhSeedOrdered(a) | AnyAccel::BvhSah(a) | AnyAccel::BvhPloc(a) | AnyAccel::BvhSweep(a) => Some(a),
         }
     }
 }
@@ -214,6 +246,9 @@ macro_rules! dispatch_accel {
             AnyAccel::BruteForce($a) => $e,
             AnyAccel::BvhSeed($a) => $e,
             AnyAccel::BvhSeedOrdered($a) => $e,
+            AnyAccel::BvhSah($a) => $e,
+            AnyAccel::BvhPloc($a) => $e,
+            AnyAccel::BvhSweep($a) => $e,
         }
     };
 }

@@ -9,24 +9,39 @@
 //!
 //! * [`layout`]: a builder's tree ([`BuildTree`]) laid out into a [`Bvh`].
 //! * [`seed_pairing`]: the seed report's builder ([`SeedPairing`]).
+//! * [`binned_sah`]: top-down, binned surface area heuristic ([`BinnedSah`]).
+//! * [`sweep_sah`]: top-down, every split candidate scored ([`SweepSah`]): the quality reference.
+//! * [`ploc`]: bottom-up, parallel locally-ordered clustering ([`Ploc`]), with [`morton`] codes
+//!   and the SAH leaf [`collapse`].
+//! * [`top_down`]: what the top-down builders share; [`parallel`]: their parallelism.
 //! * [`ordered`]: nearer child first, `t_max` shrinking at each hit (what `Bvh` answers queries with).
 //! * [`candidates`]: the seed report's own traversal ([`CandidateListBvh`]).
 //! * [`stats`]: node count, leaves, depth, memory and SAH cost.
 
+pub mod binned_sah;
 pub mod candidates;
+pub mod collapse;
 pub mod layout;
+pub mod morton;
 pub mod ordered;
+pub mod parallel;
+pub mod ploc;
 pub mod seed_pairing;
 pub mod stats;
+pub mod sweep_sah;
+pub mod top_down;
 
 use std::ops::Range;
 
 use glam::Vec3;
 
+pub use binned_sah::BinnedSah;
 pub use candidates::CandidateListBvh;
 pub use layout::{BuildKind, BuildNode, BuildTree};
+pub use ploc::Ploc;
 pub use seed_pairing::SeedPairing;
 pub use stats::{SAH_INTERSECTION_COST, SAH_TRAVERSAL_COST};
+pub use sweep_sah::SweepSah;
 
 use super::{Accel, Counters, Hit, StructureStats};
 use crate::shapes::PrimHit;

@@ -1,0 +1,201 @@
+//! The binned surface area heuristic (SAH) builder: Wald (2007), "On fast Construction of
+//! SAH-based Bounding Volume Hierarchies" (IEEE Symposium on Interactive Ray Tracing), as pbrt-v4's
+//! `BVHAggregate` builds with buckets (Pharr, Jakob and Humphreys, "Physically Based Rendering",
+//! 4th ed. 2023, section 7.3.2).
+//!
+//! At each node the centroids' box is cut into [`BinnedSah::bins`] equal slabs along each axis,
+//! every primitive is dropped into the slab of its centroid (one pass for all three axes), and the
+//! planes between slabs are scored with the SAH from the slabs' boxes and counts, swept once from
+//! each side. The best plane of the three axes is taken if it costs less than a leaf (or if the
+//! node holds more than [`BinnedSah::max_leaf`] primitives, which it must then split). Costs use
+//! [`super::SAH_TRAVERSAL_COST`] and [`super::SAH_INTERSECTION_COST`], the constants
+//! [`super::Bvh::sah_cost`] measures with: a split costs `C_t + C_i * (A_left * N_left + A_right * N_right) / A_node`, a leaf
+//! `C_i * N`. When the centroids coincide, no plane separates them and the shared top-down driver
+//! ([`super::top_down`]) splits by count. Large subtrees are built in parallel.
+
+use super::top_down::{self, PrimRef, Splitter, partition, split_beats_leaf};
+use super::{BuildTree, Bvh};
+use crate::Aabb;
+
+/// Most bins per axis.
+pub const MAX_BINS: usize = 32;
+/// Default most primitives per leaf of the SAH builders.
+pub const DEFAULT_MAX_LEAF: usize = 8;
+
+/// The binned SAH builder. `BinnedSah::default()` uses 32 bins and leaves of at most 8 primitives.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct BinnedSah {
+    /// Bins per axis, 2 to [`MAX_BINS`] (values outside are clamped). More bins find better
+    /// planes at the same linear cost per node.
+    pub bins: usize,
+    /// Most primitives per leaf (at least 1).
+    pub max_leaf: usize,
+}
+
+impl Default for BinnedSah {
+    fn default() -> Self {
+        BinnedSah { bins: MAX_BINS, max_leaf: DEFAULT_MAX_LEAF }
+    }
+}
+
+impl BinnedSah {
+    /// Builds the tree over the primitives' boxes (primitive `i` has box `boxes[i]`).
+    pub fn build(&self, boxes: &[Aabb]) -> Bvh {
+        self.build_tree(boxes).into_bvh()
+    }
+
+    /// The tree before layout.
+    pub fn build_tree(&self, boxes: &[Aabb]) -> BuildTree {
+        top_down::build_tree(self, boxes)
+    }
+}
+
+/// One slab of one axis: the boxes of the primitives whose centroids fall in it.
+#[derive(Clone, Copy, Debug)]
+struct Bin {
+    bounds: Aabb,
+    count: u32,
+}
+
+const EMPTY_BIN: Bin = Bin { bounds: Aabb::EMPTY, count: 0 };
+
+/// The bin of coordinate `c` among `bins` bins starting at `min`, `scale` bins per unit. The same
+/// function places primitives and partitions them, so the two always agree; a NaN or an out of
+/// range value saturates into the first or last bin instead of panicking.
+#[inline(always)]
+fn bin_of(c: f32, min: f32, scale: f32, bins: usize) -> usize {
+    (((c - min) * scale) as usize).min(bins - 1)
+}
+
+impl Splitter for BinnedSah {
+    type Scratch = ();
+
+    fn max_leaf(&self) -> usize {
+        self.max_leaf
+    }
+
+    fn split(
+        &self,
+        refs: &mut [PrimRef],
+        bounds: &Aabb,
+        centroid_bounds: &Aabb,
+        must_split: bool,
+        _: &mut (),
+    ) -> Option<usize> {
+        let k = self.bins.clamp(2, MAX_BINS);
+        let extent = centroid_bounds.extent();
+        // Axes along which the centroids spread; the others cannot be split by a plane.
+        let scale = extent.to_array().map(|e| if e > 0.0 { k as f32 / e } else { 0.0 });
+        if scale == [0.0; 3] {
+            return None;
+        }
+        let min = centroid_bounds.min;
+        let mut bins = [[EMPTY_BIN; MAX_BINS]; 3];
+        for r in refs.iter() {
+            for axis in 0..3 {
+                if scale[axis] > 0.0 {
+                    let bin = &mut bins[axis][bin_of(r.centroid[axis], min[axis], scale[axis], k)];
+                    bin.bounds = bin.bounds.union(&r.bounds);
+                    bin.count += 1;
+                }
+            }
+        }
+
+        // Best plane: (area-weighted count of both sides, axis, first bin of the second side).
+        let mut best: Option<(f32, usize, usize)> = None;
+        for axis in (0..3).filter(|&a| scale[a] > 0.0) {
+            let bins = &bins[axis][..k];
+            // right[i]: area times count of bins i.. (for the planes before bin i, i in 1..k).
+            let mut right = [0.0f32; MAX_BINS];
+            let (mut right_box, mut right_count) = (Aabb::EMPTY, 0u32);
+            for i in (1..k).rev() {
+                right_box = right_box.union(&bins[i].bounds);
+                right_count += bins[i].count;
+                right[i] = if right_count == 0 { f32::NAN } else { right_box.surface_area() * right_count as f32 };
+            }
+            let (mut left_box, mut left_count) = (Aabb::EMPTY, 0u32);
+            for i in 1..k {
+                left_box = left_box.union(&bins[i - 1].bounds);
+                left_count += bins[i - 1].count;
+                if left_count == 0 || right[i].is_nan() {
+                    continue;
+                }
+                let cost = left_box.surface_area() * left_count as f32 + right[i];
+                if best.is_none_or(|(c, _, _)| cost < c) {
+                    best = Some((cost, axis, i));
+                }
+            }
+        }
+        let (weighted, axis, plane) = best?;
+        if !must_split && !split_beats_leaf(weighted, bounds.surface_area(), refs.len()) {
+            return None;
+        }
+        let (lo, s) = (min[axis], scale[axis]);
+        Some(partition(refs, |r| bin_of(r.centroid[axis], lo, s, k) < plane))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::Vec3;
+
+    use super::*;
+    use crate::accel::validate::validate_bvh;
+
+    fn cube(c: Vec3, r: f32) -> Aabb {
+        Aabb::new(c - Vec3::splat(r), c + Vec3::splat(r))
+    }
+
+    #[test]
+    fn two_far_clusters_are_split_between_them() {
+        // Four small cubes near x = 0, four near x = 100: the root's plane separates the clusters.
+        let mut boxes: Vec<Aabb> = (0..4).map(|i| cube(Vec3::new(i as f32 * 0.1, 0.0, 0.0), 0.01)).collect();
+        boxes.extend((0..4).map(|i| cube(Vec3::new(100.0 + i as f32 * 0.1, 0.0, 0.0), 0.01)));
+        let bvh = BinnedSah::default().build(&boxes);
+        validate_bvh(&bvh, &boxes).unwrap();
+        let n = bvh.nodes();
+        let (left, right) = (n[1].bounds(), n[n[0].index as usize].bounds());
+        assert!(left.max.x < 1.0 && right.min.x > 99.0, "{left:?} {right:?}");
+    }
+
+    #[test]
+    fn small_scattered_primitives_get_leaves_of_their_own() {
+        // Tiny boxes far apart: any leaf of two costs more than a split, so every leaf has one.
+        let boxes: Vec<Aabb> =
+            (0..64).map(|i| cube(Vec3::new((i % 4) as f32, (i / 4 % 4) as f32, (i / 16) as f32) * 10.0, 0.1)).collect();
+        let bvh = BinnedSah::default().build(&boxes);
+        let q = validate_bvh(&bvh, &boxes).unwrap();
+        assert_eq!((q.leaves, q.max_leaf), (64, 1));
+    }
+
+    #[test]
+    fn overlapping_primitives_share_a_leaf() {
+        // Eight equal boxes, centroids slightly apart: splitting cannot shrink the boxes, so a
+        // leaf is cheaper than any split.
+        let boxes: Vec<Aabb> = (0..8).map(|i| cube(Vec3::new(i as f32 * 1e-3, 0.0, 0.0), 1.0)).collect();
+        let q = validate_bvh(&BinnedSah::default().build(&boxes), &boxes).unwrap();
+        assert_eq!((q.leaves, q.max_leaf), (1, 8));
+        // More than a leaf may hold: split anyway, into leaves no larger than allowed.
+        let builder = BinnedSah { bins: 8, max_leaf: 3 };
+        let q = validate_bvh(&builder.build(&boxes), &boxes).unwrap();
+        assert!(q.max_leaf <= 3 && q.leaves >= 3, "{q:?}");
+    }
+
+    #[test]
+    fn coincident_centroids_are_split_by_count() {
+        let boxes: Vec<Aabb> = (1..=1000).map(|i| cube(Vec3::ONE, i as f32)).collect();
+        let q = validate_bvh(&BinnedSah::default().build(&boxes), &boxes).unwrap();
+        assert!(q.max_leaf <= DEFAULT_MAX_LEAF && q.depth <= 8, "{q:?}");
+    }
+
+    #[test]
+    fn bins_out_of_range_are_clamped() {
+        let boxes: Vec<Aabb> = (0..100).map(|i| cube(Vec3::new(i as f32, 0.0, 0.0), 0.4)).collect();
+        for bins in [0, 1, 2, 1000] {
+            validate_bvh(&BinnedSah { bins, max_leaf: 4 }.build(&boxes), &boxes).unwrap();
+        }
+        assert_eq!(bin_of(f32::NAN, 0.0, 1.0, 8), 0);
+        assert_eq!(bin_of(f32::INFINITY, 0.0, 1.0, 8), 7);
+        assert_eq!(bin_of(-1.0, 0.0, 1.0, 8), 0);
+    }
+}

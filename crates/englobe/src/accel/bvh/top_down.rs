@@ -1,0 +1,282 @@
+//! Top-down construction, shared by the surface area heuristic (SAH) builders: a node over a range
+//! of primitive references is either made a leaf or split in two by a [`Splitter`], and its
+//! children are built the same way.
+//!
+//! This is the recursive scheme of Goldsmith and Salmon (1987), "Automatic Creation of Object
+//! Hierarchies for Ray Tracing", as pbrt's `BVHAggregate::buildRecursive` runs it (Pharr, Jakob and
+//! Humphreys, "Physically Based Rendering", 4th ed. 2023, section 7.3), with two guarantees added:
+//!
+//! * **No deep recursion.** The top levels, while a subtree is large, run as a bounded recursion
+//!   whose two halves are built in parallel (each writes a disjoint part of the arrays); everything
+//!   below runs from an explicit work stack. A tree as deep as it has primitives (primitives spaced
+//!   geometrically along a line peel off one by one under the SAH) is therefore built without
+//!   touching the call stack's limit.
+//! * **No giant leaf, no endless split.** A range larger than the maximum leaf size that the
+//!   splitter cannot split (all centroids at one point, so no plane separates them) is split in
+//!   the middle by count, which bounds the depth of that part by its logarithm.
+//!
+//! A subtree over `m` references gets exactly `2m - 1` node slots: its root, then the left
+//! child's `2 m_left - 1`, then the right child's. Halves can thus be built independently and the
+//! tree comes out in depth-first order; slots left over (where a leaf holds several primitives)
+//! are never reached from the root and are dropped by the layout.
+
+use glam::Vec3;
+
+use super::layout::{BuildKind, BuildNode, BuildTree};
+use super::parallel;
+use super::stats::{SAH_INTERSECTION_COST, SAH_TRAVERSAL_COST};
+use crate::Aabb;
+
+/// A primitive as the top-down builders move it around: its box, its box's centre and its index.
+/// Builders reorder these in place; the final order becomes the leaves' primitive references.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PrimRef {
+    /// The primitive's box.
+    pub bounds: Aabb,
+    /// The box's centre.
+    pub centroid: Vec3,
+    /// The primitive's index.
+    pub index: u32,
+}
+
+/// Chooses how to split a node (see [`build_tree`]).
+pub trait Splitter: Sync {
+    /// Working memory kept from node to node by one thread.
+    type Scratch: Default + Send;
+
+    /// Most primitives a leaf may hold (at least 1).
+    fn max_leaf(&self) -> usize;
+
+    /// For a node over `refs` (at least two), whose primitives' boxes span `bounds` and whose
+    /// centroids span `centroid_bounds`: `Some(mid)` after reordering `refs` so that `refs[..mid]`
+    /// go to the first child, or `None` to make a leaf. When `must_split` is true (more references
+    /// than a leaf may hold) the splitter returns its best split even if a leaf would cost less,
+    /// and `None` only if it finds no split at all; the builder then splits by count. A `mid` of
+    /// 0 or `refs.len()` counts as `None`.
+    fn split(
+        &self,
+        refs: &mut [PrimRef],
+        bounds: &Aabb,
+        centroid_bounds: &Aabb,
+        must_split: bool,
+        scratch: &mut Self::Scratch,
+    ) -> Option<usize>;
+}
+
+/// Subtrees at least this large are built in parallel (below it a task costs less than spawning).
+const PARALLEL_MIN: usize = 4096;
+/// Levels of the bounded recursion that builds large subtrees in parallel; below it, or below
+/// [`PARALLEL_MIN`] references, the explicit work stack takes over.
+const PARALLEL_DEPTH: u32 = 40;
+
+/// Builds the tree over `boxes` (primitive `i` has box `boxes[i]`) with `splitter`.
+pub fn build_tree<S: Splitter>(splitter: &S, boxes: &[Aabb]) -> BuildTree {
+    let n = boxes.len();
+    if n == 0 {
+        return BuildTree::default();
+    }
+    let mut refs = vec![PrimRef { bounds: Aabb::EMPTY, centroid: Vec3::ZERO, index: 0 }; n];
+    parallel::fill_indexed(&mut refs, 1 << 14, |i| PrimRef {
+        bounds: boxes[i],
+        centroid: boxes[i].center(),
+        index: i as u32,
+    });
+    let unused = BuildNode { bounds: Aabb::EMPTY, kind: BuildKind::Leaf { first: 0, count: 0 } };
+    let mut nodes = vec![unused; 2 * n - 1];
+    build_parallel(splitter, &mut nodes, 0, &mut refs, 0, 0);
+    let mut prims = vec![0u32; n];
+    parallel::fill_indexed(&mut prims, 1 << 14, |i| refs[i].index);
+    BuildTree { nodes, prims, root: 0 }
+}
+
+/// The union of the references' boxes and the box around their centroids.
+pub fn range_bounds(refs: &[PrimRef]) -> (Aabb, Aabb) {
+    refs.iter().fold((Aabb::EMPTY, Aabb::EMPTY), |(b, c), r| (b.union(&r.bounds), c.grown(r.centroid)))
+}
+
+/// Where to split `refs`: `Some(mid)` with `0 < mid < len`, or `None` for a leaf.
+fn decide<S: Splitter>(
+    splitter: &S,
+    refs: &mut [PrimRef],
+    bounds: &Aabb,
+    centroid_bounds: &Aabb,
+    scratch: &mut S::Scratch,
+) -> Option<usize> {
+    let n = refs.len();
+    if n <= 1 {
+        return None;
+    }
+    let must_split = n > splitter.max_leaf().max(1);
+    match splitter.split(refs, bounds, centroid_bounds, must_split, scratch) {
+        Some(mid) if mid > 0 && mid < n => Some(mid),
+        // Nothing separates the centroids: split by count, which keeps this part's depth
+        // logarithmic.
+        _ if must_split => Some(n / 2),
+        _ => None,
+    }
+}
+
+/// Builds the subtree over `refs` into `nodes` (its `2 * refs.len() - 1` slots; global index of
+/// the first: `node_base`); its references are `ref_base..` of the final order. Large subtrees
+/// build their halves in parallel, for at most [`PARALLEL_DEPTH`] levels.
+fn build_parallel<S: Splitter>(
+    splitter: &S,
+    nodes: &mut [BuildNode],
+    node_base: u32,
+    refs: &mut [PrimRef],
+    ref_base: u32,
+    level: u32,
+) {
+    if refs.len() < PARALLEL_MIN || level >= PARALLEL_DEPTH {
+        build_sequential(splitter, nodes, node_base, refs, ref_base, &mut S::Scratch::default());
+        return;
+    }
+    let (bounds, centroid_bounds) = range_bounds(refs);
+    let mut scratch = S::Scratch::default();
+    let Some(mid) = decide(splitter, refs, &bounds, &centroid_bounds, &mut scratch) else {
+        nodes[0] = BuildNode { bounds, kind: BuildKind::Leaf { first: ref_base, count: refs.len() as u32 } };
+        return;
+    };
+    drop(scratch);
+    let right = node_base + 2 * mid as u32;
+    nodes[0] = BuildNode { bounds, kind: BuildKind::Interior { children: [node_base + 1, right] } };
+    let (left_nodes, right_nodes) = nodes[1..].split_at_mut(2 * mid - 1);
+    let (left_refs, right_refs) = refs.split_at_mut(mid);
+    parallel::join(
+        || build_parallel(splitter, left_nodes, node_base + 1, left_refs, ref_base, level + 1),
+        || build_parallel(splitter, right_nodes, right, right_refs, ref_base + mid as u32, level + 1),
+    );
+}
+
+/// Builds the subtree over `refs` into `nodes` (as [`build_parallel`]) from an explicit work
+/// stack, whatever its depth.
+fn build_sequential<S: Splitter>(
+    splitter: &S,
+    nodes: &mut [BuildNode],
+    node_base: u32,
+    refs: &mut [PrimRef],
+    ref_base: u32,
+    scratch: &mut S::Scratch,
+) {
+    // (slot in `nodes`, range in `refs`)
+    let mut stack: Vec<(usize, usize, usize)> = vec![(0, 0, refs.len())];
+    while let Some((slot, start, end)) = stack.pop() {
+        let range = &mut refs[start..end];
+        let (bounds, centroid_bounds) = range_bounds(range);
+        nodes[slot] = match decide(splitter, range, &bounds, &centroid_bounds, scratch) {
+            None => BuildNode {
+                bounds,
+                kind: BuildKind::Leaf { first: ref_base + start as u32, count: (end - start) as u32 },
+            },
+            Some(mid) => {
+                let (left, right) = (slot + 1, slot + 2 * mid);
+                stack.push((right, start + mid, end));
+                stack.push((left, start, start + mid));
+                BuildNode {
+                    bounds,
+                    kind: BuildKind::Interior { children: [node_base + left as u32, node_base + right as u32] },
+                }
+            }
+        };
+    }
+}
+
+/// Whether splitting a node of surface area `area` over `n` primitives beats making it a leaf,
+/// when the children's boxes' areas times their counts add up to `weighted`: a split costs
+/// `C_t + C_i * weighted / area`, a leaf `C_i * n` (the constants of [`super::stats`]). A node
+/// without area (all its primitives on one point or segment) gains nothing by a split.
+pub fn split_beats_leaf(weighted: f32, area: f32, n: usize) -> bool {
+    area > 0.0 && SAH_TRAVERSAL_COST + SAH_INTERSECTION_COST * weighted / area < SAH_INTERSECTION_COST * n as f32
+}
+
+/// Reorders `refs` so that those for which `left` holds come first; returns how many they are.
+/// (Hoare's two-pointer partition: linear, in place, not stable, deterministic.)
+pub fn partition(refs: &mut [PrimRef], mut left: impl FnMut(&PrimRef) -> bool) -> usize {
+    let (mut i, mut j) = (0usize, refs.len());
+    loop {
+        while i < j && left(&refs[i]) {
+            i += 1;
+        }
+        while i < j && !left(&refs[j - 1]) {
+            j -= 1;
+        }
+        if i >= j {
+            return i;
+        }
+        refs.swap(i, j - 1);
+        i += 1;
+        j -= 1;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::accel::validate::validate_bvh;
+
+    /// Never splits: every range larger than a leaf is split by count.
+    struct NoSplit(usize);
+
+    impl Splitter for NoSplit {
+        type Scratch = ();
+        fn max_leaf(&self) -> usize {
+            self.0
+        }
+        fn split(&self, _: &mut [PrimRef], _: &Aabb, _: &Aabb, _: bool, _: &mut ()) -> Option<usize> {
+            None
+        }
+    }
+
+    /// Splits off the first reference: the deepest tree there is.
+    struct PeelOne;
+
+    impl Splitter for PeelOne {
+        type Scratch = ();
+        fn max_leaf(&self) -> usize {
+            1
+        }
+        fn split(&self, _: &mut [PrimRef], _: &Aabb, _: &Aabb, _: bool, _: &mut ()) -> Option<usize> {
+            Some(1)
+        }
+    }
+
+    fn boxes(n: usize) -> Vec<Aabb> {
+        (0..n).map(|i| Aabb::new(Vec3::new(i as f32, 0.0, 0.0), Vec3::new(i as f32 + 1.0, 1.0, 1.0))).collect()
+    }
+
+    #[test]
+    fn count_splits_give_small_leaves_and_logarithmic_depth() {
+        for n in [1usize, 2, 3, 4, 5, 17, 100, 10_000] {
+            let b = boxes(n);
+            let bvh = build_tree(&NoSplit(4), &b).into_bvh();
+            let q = validate_bvh(&bvh, &b).unwrap();
+            assert!(q.max_leaf <= 4, "n = {n}: {q:?}");
+            assert!(q.depth <= (n as f64).log2().ceil() as u32, "n = {n}: {q:?}");
+        }
+    }
+
+    #[test]
+    fn a_chain_as_deep_as_its_primitives_is_built_without_recursion() {
+        // Each level scans its range, so this is quadratic: kept small enough to stay fast, deep
+        // enough that one call frame per level would be a risk on a thread's small stack.
+        let n = 20_000;
+        let b = boxes(n);
+        let bvh = build_tree(&PeelOne, &b).into_bvh();
+        assert_eq!(bvh.depth() as usize, n - 1);
+        assert_eq!(validate_bvh(&bvh, &b).unwrap().leaves, n);
+    }
+
+    #[test]
+    fn partition_puts_the_chosen_first() {
+        let b = boxes(11);
+        let mut refs: Vec<PrimRef> =
+            b.iter().enumerate().map(|(i, b)| PrimRef { bounds: *b, centroid: b.center(), index: i as u32 }).collect();
+        let mid = partition(&mut refs, |r| r.index % 3 == 0);
+        assert_eq!(mid, 4);
+        assert!(refs[..mid].iter().all(|r| r.index % 3 == 0));
+        assert!(refs[mid..].iter().all(|r| r.index % 3 != 0));
+        assert_eq!(partition(&mut refs, |_| true), 11);
+        assert_eq!(partition(&mut refs, |_| false), 0);
+        assert_eq!(partition(&mut [], |_| true), 0);
+    }
+}
