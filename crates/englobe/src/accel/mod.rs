@@ -169,7 +169,7 @@ impl AccelKind {
             }
             AccelKind::BvhSah => "binary BVH built top-down with the binned surface area heuristic (32 bins per axis)",
             AccelKind::BvhPloc => {
-                "binary BVH built bottom-up by parallel locally-ordered clustering, leaves collapsed by the SAH"
+                "binary BVH built bottom-up by parallel locally-ordered clustering, treelets restructured, leaves collapsed by the SAH"
             }
             AccelKind::BvhSweep => {
                 "binary BVH built top-down with the full-sweep surface area heuristic (the quality reference)"

@@ -12,7 +12,7 @@
 //! * [`binned_sah`]: top-down, binned surface area heuristic ([`BinnedSah`]).
 //! * [`sweep_sah`]: top-down, every split candidate scored ([`SweepSah`]): the quality reference.
 //! * [`ploc`]: bottom-up, parallel locally-ordered clustering ([`Ploc`]), with [`morton`] codes
-//!   and the SAH leaf [`collapse`].
+//!   and the SAH leaf [`collapse`]; [`treelet`] restructuring improves its trees.
 //! * [`top_down`]: what the top-down builders share; [`parallel`]: their parallelism.
 //! * [`ordered`]: nearer child first, `t_max` shrinking at each hit (what `Bvh` answers queries with).
 //! * [`candidates`]: the seed report's own traversal ([`CandidateListBvh`]).
@@ -30,6 +30,7 @@ pub mod seed_pairing;
 pub mod stats;
 pub mod sweep_sah;
 pub mod top_down;
+pub mod treelet;
 
 use std::ops::Range;
 
