@@ -3,8 +3,9 @@
 //! [`validate_bvh`] walks the tree from the root with an explicit stack (so degenerate trees are
 //! fine) and checks that:
 //!
-//! * the layout is sound: child and leaf indices are in range, interior nodes have a count of 0,
-//!   the first child follows its parent and the second comes after it;
+//! * the layout is sound: child and leaf indices are in range, every leaf holds at least one
+//!   primitive, interior nodes' flags name an axis, the first child follows its parent and the
+//!   second comes after it;
 //! * every node is reached exactly once from the root (no orphans, no sharing);
 //! * every primitive is referenced exactly once, and only primitives that exist;
 //! * every child box lies inside its parent's, and every leaf box holds its primitives' boxes;
@@ -13,7 +14,7 @@
 //! On success it returns [`BvhQuality`]: counts, depth, leaf sizes, SAH cost (see
 //! [`crate::accel::bvh::stats`]) and whether every box is the tightest possible.
 
-use super::bvh::Bvh;
+use super::bvh::{Bvh, INTERIOR, SECOND_IS_LOWER};
 use crate::Aabb;
 
 /// A broken invariant, naming the node or primitive at fault.
@@ -48,6 +49,20 @@ pub enum BvhError {
         end: usize,
         /// Length of `prim_indices`.
         len: usize,
+    },
+    /// A leaf without primitives.
+    #[error("leaf {node} holds no primitive")]
+    EmptyLeaf {
+        /// The leaf.
+        node: usize,
+    },
+    /// An interior node whose flags are not an axis and the lower-child flag.
+    #[error("interior node {node} has malformed flags {count:#x}")]
+    BadFlags {
+        /// The node.
+        node: usize,
+        /// Its `count` field.
+        count: u32,
     },
     /// A node reached twice from the root.
     #[error("node {node} is reached more than once")]
@@ -189,6 +204,9 @@ pub fn validate_bvh(bvh: &Bvh, prim_boxes: &[Aabb]) -> Result<BvhQuality, BvhErr
         }
         if node.is_leaf() {
             let range = node.prim_range();
+            if range.is_empty() {
+                return Err(BvhError::EmptyLeaf { node: index });
+            }
             if range.end > refs.len() {
                 return Err(BvhError::BadLeafRange {
                     node: index,
@@ -214,6 +232,9 @@ pub fn validate_bvh(bvh: &Bvh, prim_boxes: &[Aabb]) -> Result<BvhQuality, BvhErr
             }
             tight &= union == bounds;
         } else {
+            if node.count & !(INTERIOR | 3 | SECOND_IS_LOWER) != 0 || node.axis() > 2 {
+                return Err(BvhError::BadFlags { node: index, count: node.count });
+            }
             let (first, second) = (index + 1, node.index as usize);
             for child in [first, second] {
                 if child >= nodes.len() || child <= index {
@@ -333,6 +354,29 @@ mod tests {
         assert!(matches!(
             validate_bvh(&Bvh::from_parts(nodes, vec![0, 1, 2, 9], depth), &boxes(4)),
             Err(BvhError::UnknownPrimitive { prim: 9, .. })
+        ));
+    }
+
+    #[test]
+    fn empty_leaves_and_bad_flags_are_caught() {
+        let (mut nodes, refs, depth) = parts(4);
+        let leaf = nodes.iter().position(BvhNode::is_leaf).unwrap();
+        nodes[leaf].count = 0;
+        assert_eq!(
+            validate_bvh(&Bvh::from_parts(nodes, refs.clone(), depth), &boxes(4)),
+            Err(BvhError::EmptyLeaf { node: leaf })
+        );
+        let (mut nodes, _, _) = parts(4);
+        nodes[0].count |= 3;
+        assert!(matches!(
+            validate_bvh(&Bvh::from_parts(nodes, refs.clone(), depth), &boxes(4)),
+            Err(BvhError::BadFlags { node: 0, .. })
+        ));
+        let (mut nodes, _, _) = parts(4);
+        nodes[0].count |= 1 << 8;
+        assert!(matches!(
+            validate_bvh(&Bvh::from_parts(nodes, refs, depth), &boxes(4)),
+            Err(BvhError::BadFlags { node: 0, .. })
         ));
     }
 

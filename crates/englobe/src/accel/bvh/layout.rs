@@ -6,7 +6,8 @@
 //! first child right after its parent, as pbrt's `flattenBVH` does (Pharr, Jakob and Humphreys,
 //! "Physically Based Rendering", 3rd ed. 2016, section 4.3.4), and records the depth. The walk uses
 //! an explicit stack, so a degenerate tree (a chain as deep as it has primitives) is laid out
-//! without exhausting the call stack.
+//! without exhausting the call stack. Each interior node records the axis along which its
+//! children lie most apart, and which child is lower along it ([`order_axis`]).
 
 use super::{Bvh, BvhNode};
 use crate::Aabb;
@@ -79,8 +80,10 @@ impl BuildTree {
                     prim_indices.extend_from_slice(&self.prims[range]);
                 }
                 BuildKind::Interior { children: [first, second] } => {
+                    let (axis, second_is_lower) =
+                        order_axis(&self.nodes[first as usize].bounds, &self.nodes[second as usize].bounds);
                     // The second child's index is patched in when it is laid out.
-                    nodes.push(BvhNode::interior(node.bounds, 0));
+                    nodes.push(BvhNode::interior(node.bounds, 0, axis, second_is_lower));
                     stack.push((second, Some(here), level + 1));
                     stack.push((first, None, level + 1));
                 }
@@ -88,6 +91,25 @@ impl BuildTree {
         }
         Bvh::from_parts(nodes, prim_indices, depth)
     }
+}
+
+/// The axis along which two sibling boxes lie most apart, and whether the second lies below the
+/// first along it: the axis of the largest gap between them (the least overlap, when they
+/// overlap along every axis), measured as the distance between their centres less their half
+/// extents. A traversal that enters the lower child first when the ray goes up that axis then
+/// enters the nearer one first as often as ordering by entry distance would (see
+/// [`super::ordered`] for what was measured).
+pub fn order_axis(first: &Aabb, second: &Aabb) -> (usize, bool) {
+    let (a, b) = (first.center(), second.center());
+    let gap = (b - a).abs() - (first.extent() + second.extent()) * 0.5;
+    let axis = if gap.x >= gap.y && gap.x >= gap.z {
+        0
+    } else if gap.y >= gap.z {
+        1
+    } else {
+        2
+    };
+    (axis, b[axis] < a[axis])
 }
 
 #[cfg(test)]
@@ -142,6 +164,30 @@ mod tests {
         let bvh = tree.into_bvh();
         assert_eq!(bvh.nodes().len(), 2 * n as usize - 1);
         assert_eq!(bvh.depth(), n - 1);
+    }
+
+    #[test]
+    fn the_order_axis_is_where_the_children_overlap_least() {
+        // Apart along x by a gap of 1; their centres lie farther apart along y.
+        let a = Aabb::new(Vec3::ZERO, Vec3::new(1.0, 10.0, 1.0));
+        let b = Aabb::new(Vec3::new(2.0, 5.0, 0.0), Vec3::new(3.0, 16.0, 1.0));
+        assert_eq!(order_axis(&a, &b), (0, false));
+        assert_eq!(order_axis(&b, &a), (0, true));
+        // Overlapping along every axis: the axis of least overlap.
+        let c = Aabb::new(Vec3::ZERO, Vec3::splat(2.0));
+        let d = Aabb::new(Vec3::new(0.5, -1.5, 0.5), Vec3::new(2.5, 0.5, 2.5));
+        assert_eq!(order_axis(&c, &d), (1, true));
+        let bvh = BuildTree {
+            nodes: vec![
+                BuildNode { bounds: b, kind: BuildKind::Leaf { first: 0, count: 1 } },
+                BuildNode { bounds: a, kind: BuildKind::Leaf { first: 1, count: 1 } },
+                BuildNode { bounds: a.union(&b), kind: BuildKind::Interior { children: [0, 1] } },
+            ],
+            prims: vec![0, 1],
+            root: 2,
+        }
+        .into_bvh();
+        assert_eq!((bvh.nodes()[0].axis(), bvh.nodes()[0].count & super::super::SECOND_IS_LOWER != 0), (0, true));
     }
 
     #[test]

@@ -27,6 +27,7 @@ pub mod ordered;
 pub mod parallel;
 pub mod ploc;
 pub mod seed_pairing;
+pub mod slab;
 pub mod stats;
 pub mod sweep_sah;
 pub mod top_down;
@@ -50,6 +51,10 @@ use crate::{Aabb, Ray};
 
 /// One node of a [`Bvh`]: its box, and either its second child (interior node; the first child is
 /// the next node of the array) or its range of primitive references (leaf). 32 bytes.
+///
+/// An interior node also records the axis along which its children lie apart (the axis of the
+/// largest distance between their boxes' centres) and which of them lies on the lower side, so
+/// that a traversal can enter the nearer child first from the sign of the ray's direction alone.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[repr(C)]
 pub struct BvhNode {
@@ -60,19 +65,29 @@ pub struct BvhNode {
     pub index: u32,
     /// Upper corner of the node's box.
     pub max: [f32; 3],
-    /// Number of primitives of a leaf; 0 for an interior node.
+    /// Leaf: its number of primitives (1 to 2^31 - 1). Interior node: [`INTERIOR`], plus the
+    /// axis (0, 1 or 2) in the two low bits, plus [`SECOND_IS_LOWER`] if the second child's centre
+    /// lies below the first's along that axis.
     pub count: u32,
 }
 
 const _: () = assert!(std::mem::size_of::<BvhNode>() == 32);
 
+/// Flag of [`BvhNode::count`] marking an interior node.
+pub const INTERIOR: u32 = 1 << 31;
+/// Flag of an interior node's [`BvhNode::count`]: its second child lies on the lower side of its
+/// axis, so rays going up that axis should enter it first.
+pub const SECOND_IS_LOWER: u32 = 1 << 2;
+
 impl BvhNode {
-    /// An interior node whose second child is `second_child`.
-    pub fn interior(bounds: Aabb, second_child: u32) -> Self {
-        BvhNode { min: bounds.min.to_array(), index: second_child, max: bounds.max.to_array(), count: 0 }
+    /// An interior node whose second child is `second_child`, its children lying apart along
+    /// `axis` (0, 1 or 2), the second below the first if `second_is_lower`.
+    pub fn interior(bounds: Aabb, second_child: u32, axis: usize, second_is_lower: bool) -> Self {
+        let count = INTERIOR | (axis as u32 & 3) | if second_is_lower { SECOND_IS_LOWER } else { 0 };
+        BvhNode { min: bounds.min.to_array(), index: second_child, max: bounds.max.to_array(), count }
     }
 
-    /// A leaf holding `count >= 1` references starting at `first`.
+    /// A leaf holding `count` references (1 to 2^31 - 1) starting at `first`.
     pub fn leaf(bounds: Aabb, first: u32, count: u32) -> Self {
         BvhNode { min: bounds.min.to_array(), index: first, max: bounds.max.to_array(), count }
     }
@@ -86,13 +101,25 @@ impl BvhNode {
     /// True for a leaf.
     #[inline(always)]
     pub fn is_leaf(&self) -> bool {
-        self.count > 0
+        self.count & INTERIOR == 0
+    }
+
+    /// A leaf's number of primitives (0 for an interior node).
+    #[inline(always)]
+    pub fn prim_count(&self) -> u32 {
+        if self.is_leaf() { self.count } else { 0 }
+    }
+
+    /// An interior node's axis (meaningless for a leaf).
+    #[inline(always)]
+    pub fn axis(&self) -> usize {
+        (self.count & 3) as usize
     }
 
     /// A leaf's range in [`Bvh::prim_indices`] (empty for interior nodes).
     #[inline(always)]
     pub fn prim_range(&self) -> Range<usize> {
-        if self.count == 0 { 0..0 } else { self.index as usize..self.index as usize + self.count as usize }
+        if self.is_leaf() { self.index as usize..self.index as usize + self.count as usize } else { 0..0 }
     }
 }
 
