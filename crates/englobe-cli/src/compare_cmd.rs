@@ -1,6 +1,8 @@
 //! `englobe compare SCENE`: every structure of `AccelKind::ALL` built for one scene and used to
-//! render it: build time, memory, node count, depth, rays per second, and the work per ray (exact
-//! tests, nodes visited, box tests); then whether its image is brute force's, bit for bit.
+//! render it: build time, memory, rays per second (and how many times brute force's), and the
+//! work per ray (exact tests, nodes visited, box tests); then whether its image is brute force's,
+//! bit for bit. A second table gives the quality of every tree: SAH cost (and its ratio to the
+//! full-sweep builder's), interior nodes, leaves, depth and the leaves' sizes.
 //!
 //! A structure whose full render would take longer than the time budget (brute force on a large
 //! mesh) is measured on a regular sample of the pixels instead: every `n`-th pixel of every
@@ -12,6 +14,8 @@ use std::process::ExitCode;
 
 use clap::Args;
 use englobe::AccelKind;
+use englobe::accel::LEAF_SIZE_BUCKETS;
+use englobe::accel::bvh::{SAH_INTERSECTION_COST, SAH_TRAVERSAL_COST};
 use englobe_render::{Film, RenderOutput};
 use englobe_scene::Scene;
 use serde::Serialize;
@@ -62,14 +66,24 @@ struct Row {
     memory_bytes: usize,
     /// Interior nodes plus leaves.
     nodes: usize,
+    interior_nodes: usize,
     leaves: usize,
     depth: usize,
+    /// Primitive references held by the leaves.
+    prim_refs: usize,
+    /// SAH cost, with the constants of the report's `sah_constants`.
     sah_cost: Option<f32>,
+    /// SAH cost over bvh-sweep's, when both were built.
+    sah_vs_sweep: Option<f64>,
+    /// Leaves of 1, 2, ..., 8 primitives, then of more.
+    leaf_sizes: [usize; LEAF_SIZE_BUCKETS],
     /// Rays of the timed render (all rays of the pixels rendered).
     rays: u64,
     /// Seconds of the timed render (counting off).
     seconds: f64,
     rays_per_second: f64,
+    /// Rays per second over brute force's (both measured in this run).
+    speedup_vs_none: f64,
     exact_tests_per_ray: f64,
     nodes_visited_per_ray: f64,
     box_tests_per_ray: f64,
@@ -91,7 +105,17 @@ struct CompareReport<'a> {
     samples: u32,
     threads: usize,
     budget_seconds: f64,
+    sah_constants: SahConstants,
     rows: Vec<Row>,
+}
+
+/// The constants the SAH costs are computed with (see `englobe::accel::bvh::stats`).
+#[derive(Serialize)]
+struct SahConstants {
+    /// Cost of visiting an interior node.
+    traversal: f32,
+    /// Cost of one exact primitive test.
+    intersection: f32,
 }
 
 /// Coarsest stride of the probe render.
@@ -132,8 +156,10 @@ pub fn run(args: CompareArgs) -> anyhow::Result<ExitCode> {
         let (compared, differing) = compare_films(film_ref, *stride_ref, &timed.film, stride);
         rows.push(row(kind, build_seconds, &world.stats(), &timed, &counted, stride, compared, differing));
     }
+    relate_rows(&mut rows);
     let threads = pool.current_num_threads();
     print!("{}", table(&scene_name, primitives, width, height, samples, threads, &rows));
+    print!("{}", quality_table(&rows));
     if let Some(path) = &args.json {
         let report = CompareReport {
             scene: &scene_name,
@@ -143,6 +169,7 @@ pub fn run(args: CompareArgs) -> anyhow::Result<ExitCode> {
             samples,
             threads,
             budget_seconds: args.budget,
+            sah_constants: SahConstants { traversal: SAH_TRAVERSAL_COST, intersection: SAH_INTERSECTION_COST },
             rows: rows.clone(),
         };
         write_json(path, &report)?;
@@ -191,12 +218,17 @@ fn row(
         build_seconds,
         memory_bytes: s.memory_bytes,
         nodes: s.nodes + s.leaves,
+        interior_nodes: s.nodes,
         leaves: s.leaves,
         depth: s.depth,
+        prim_refs: s.prim_refs,
         sah_cost: s.sah_cost,
+        sah_vs_sweep: None,
+        leaf_sizes: s.leaf_sizes,
         rays,
         seconds: timed.seconds,
         rays_per_second: if timed.seconds > 0.0 { rays as f64 / timed.seconds } else { 0.0 },
+        speedup_vs_none: 0.0,
         exact_tests_per_ray: per_ray(work.exact_tests),
         nodes_visited_per_ray: per_ray(work.nodes_visited),
         box_tests_per_ray: per_ray(work.box_tests),
@@ -208,26 +240,42 @@ fn row(
     }
 }
 
+/// Fills in what each row says relative to the others: speed over brute force's, SAH cost over
+/// bvh-sweep's.
+fn relate_rows(rows: &mut [Row]) {
+    let none = rows.iter().find(|r| r.accel == AccelKind::None.name()).map(|r| r.rays_per_second);
+    let sweep = rows.iter().find(|r| r.accel == AccelKind::BvhSweep.name()).and_then(|r| r.sah_cost);
+    for r in rows.iter_mut() {
+        r.speedup_vs_none = match none {
+            Some(n) if n > 0.0 => r.rays_per_second / n,
+            _ => 0.0,
+        };
+        r.sah_vs_sweep = match (r.sah_cost, sweep) {
+            (Some(c), Some(s)) if s > 0.0 => Some(c as f64 / s as f64),
+            _ => None,
+        };
+    }
+}
+
 fn table(scene: &str, primitives: usize, w: u32, h: u32, spp: u32, threads: usize, rows: &[Row]) -> String {
     let mut out = format!(
         "{scene}: {primitives} primitives in the structure, {w}x{h}, {spp} sample(s) per pixel, {threads} threads{}\n\n",
         if cfg!(debug_assertions) { ", debug build (times are not representative)" } else { "" },
     );
     out += &format!(
-        "{:<18} {:>10} {:>10} {:>9} {:>6} {:>9} {:>10} {:>10} {:>10} {:>8}  {}\n",
+        "{:<18} {:>10} {:>10} {:>9} {:>9} {:>10} {:>10} {:>10} {:>8}  {}\n",
         "accelerator",
         "build ms",
         "memory",
-        "nodes",
-        "depth",
         "Mrays/s",
+        "x none",
         "tests/ray",
         "nodes/ray",
         "boxes/ray",
         "pixels",
         "image"
     );
-    out += &format!("{}\n", "-".repeat(120));
+    out += &format!("{}\n", "-".repeat(112));
     for r in rows {
         let pixels = if r.sampled { format!("1/{}", r.pixel_stride * r.pixel_stride) } else { "all".to_owned() };
         let image = match (r.accel == AccelKind::None.name(), r.image_equal) {
@@ -236,13 +284,12 @@ fn table(scene: &str, primitives: usize, w: u32, h: u32, spp: u32, threads: usiz
             (false, false) => format!("{} of {} pixels differ", r.differing_pixels, r.compared_pixels),
         };
         out += &format!(
-            "{:<18} {:>10.2} {:>10} {:>9} {:>6} {:>9.3} {:>10.2} {:>10.2} {:>10.2} {:>8}  {}\n",
+            "{:<18} {:>10.2} {:>10} {:>9.3} {:>9.1} {:>10.2} {:>10.2} {:>10.2} {:>8}  {}\n",
             r.accel,
             r.build_seconds * 1e3,
             bytes(r.memory_bytes),
-            r.nodes,
-            r.depth,
             r.rays_per_second / 1e6,
+            r.speedup_vs_none,
             r.exact_tests_per_ray,
             r.nodes_visited_per_ray,
             r.box_tests_per_ray,
@@ -253,6 +300,47 @@ fn table(scene: &str, primitives: usize, w: u32, h: u32, spp: u32, threads: usiz
     if rows.iter().any(|r| r.sampled) {
         out += "\npixels 1/N: too slow for the time budget (--budget), so timed and counted on a regular sample \
                 of 1 pixel in N (--full renders every pixel); images are compared on the pixels both rendered.\n";
+    }
+    out
+}
+
+/// The shape and SAH cost of every structure that has them.
+fn quality_table(rows: &[Row]) -> String {
+    let trees: Vec<&Row> = rows.iter().filter(|r| r.sah_cost.is_some()).collect();
+    if trees.is_empty() {
+        return String::new();
+    }
+    let mut out = format!(
+        "\nQuality: SAH cost = expected cost of a ray that hits the root box, {SAH_TRAVERSAL_COST} per interior node \
+         and {SAH_INTERSECTION_COST} per primitive of a leaf, each node weighted by its area over the root's.\n\n"
+    );
+    out += &format!(
+        "{:<18} {:>10} {:>9} {:>9} {:>9} {:>6}  {:<44} {:>6}\n",
+        "accelerator",
+        "SAH cost",
+        "vs sweep",
+        "interior",
+        "leaves",
+        "depth",
+        "leaves of 1 2 3 4 5 6 7 8 9+ primitives",
+        "mean"
+    );
+    out += &format!("{}\n", "-".repeat(122));
+    for r in trees {
+        let vs_sweep = r.sah_vs_sweep.map_or("-".to_owned(), |v| format!("{v:.3}"));
+        let sizes = r.leaf_sizes.iter().map(|n| n.to_string()).collect::<Vec<_>>().join(" ");
+        let mean = if r.leaves == 0 { 0.0 } else { r.prim_refs as f64 / r.leaves as f64 };
+        out += &format!(
+            "{:<18} {:>10.3} {:>9} {:>9} {:>9} {:>6}  {:<44} {:>6.2}\n",
+            r.accel,
+            r.sah_cost.unwrap_or(0.0),
+            vs_sweep,
+            r.interior_nodes,
+            r.leaves,
+            r.depth,
+            sizes,
+            mean
+        );
     }
     out
 }

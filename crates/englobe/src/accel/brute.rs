@@ -61,6 +61,7 @@ impl Accel for BruteForce {
             prim_refs: self.count as usize,
             memory_bytes: std::mem::size_of::<Self>(),
             sah_cost: None,
+            leaf_sizes: [0; crate::accel::LEAF_SIZE_BUCKETS],
         }
     }
 }

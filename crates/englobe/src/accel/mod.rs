@@ -76,9 +76,17 @@ pub struct StructureStats {
     pub prim_refs: usize,
     /// Bytes used by the structure.
     pub memory_bytes: usize,
-    /// Expected cost of a random ray under the surface area heuristic, where it applies.
+    /// Expected cost of a random ray under the surface area heuristic, where it applies (see
+    /// [`bvh::stats`] for the constants).
     pub sah_cost: Option<f32>,
+    /// Leaves by number of primitives: `leaf_sizes[k]` leaves hold `k + 1` primitives, for `k` up
+    /// to [`LEAF_SIZE_BUCKETS`]` - 2`; the last entry counts all larger leaves. All zero where
+    /// there are no leaves.
+    pub leaf_sizes: [usize; LEAF_SIZE_BUCKETS],
 }
+
+/// Entries of [`StructureStats::leaf_sizes`]: leaves of 1 to 8 primitives, then larger ones.
+pub const LEAF_SIZE_BUCKETS: usize = 9;
 
 /// The closest hit found so far during a query, and the ray shrunk to it. Every structure offers
 /// its candidates through this, so they all break ties the same way.

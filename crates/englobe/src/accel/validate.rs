@@ -14,6 +14,7 @@
 //! On success it returns [`BvhQuality`]: counts, depth, leaf sizes, SAH cost (see
 //! [`crate::accel::bvh::stats`]) and whether every box is the tightest possible.
 
+use super::LEAF_SIZE_BUCKETS;
 use super::bvh::{Bvh, INTERIOR, SECOND_IS_LOWER};
 use crate::Aabb;
 
@@ -151,6 +152,8 @@ pub struct BvhQuality {
     pub max_leaf: usize,
     /// Mean primitives per leaf.
     pub mean_leaf: f64,
+    /// Leaves by number of primitives (see [`crate::accel::StructureStats::leaf_sizes`]).
+    pub leaf_sizes: [usize; LEAF_SIZE_BUCKETS],
     /// SAH cost (see [`Bvh::sah_cost`]).
     pub sah_cost: f32,
     /// True if every leaf box is exactly the union of its primitives' boxes and every interior box
@@ -175,6 +178,7 @@ pub fn validate_bvh(bvh: &Bvh, prim_boxes: &[Aabb]) -> Result<BvhQuality, BvhErr
                 min_leaf: 0,
                 max_leaf: 0,
                 mean_leaf: 0.0,
+                leaf_sizes: [0; LEAF_SIZE_BUCKETS],
                 sah_cost: 0.0,
                 tight: true,
             });
@@ -270,6 +274,7 @@ pub fn validate_bvh(bvh: &Bvh, prim_boxes: &[Aabb]) -> Result<BvhQuality, BvhErr
         min_leaf,
         max_leaf,
         mean_leaf: covered as f64 / leaves as f64,
+        leaf_sizes: bvh.leaf_sizes(),
         sah_cost: bvh.sah_cost(),
         tight,
     })

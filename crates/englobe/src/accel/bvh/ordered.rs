@@ -19,6 +19,12 @@
 //! children's boxes (see [`super::layout`]) visits 1 % more and wins. Testing a node's own box
 //! when it is popped instead (pbrt-v4's form, one box test per node) took 71.6 ms and 83.4 ms.
 //!
+//! Occlusion queries enter the child *farther* along the ray first. A shadow ray starts on the
+//! surface it leaves, inside the box of that surface's primitive and its neighbours, which rarely
+//! occlude it; its occluders lie farther along. On the seed report's test 1 this cut the shadow
+//! rays' exact tests by 9 % (668 916 to 606 041, within 1 % of what an oracle that always tests
+//! the occluder first would need) and on the bunny scene by 2 %, with fewer nodes visited.
+//!
 //! The stack holds at most one entry per level of the path from the root, so the tree's recorded
 //! depth bounds it: trees up to [`INLINE_STACK`] deep use a fixed array on the call stack; deeper
 //! ones (only degenerate builds are) use a buffer kept per thread and grown to the depth once, so
@@ -144,8 +150,8 @@ impl Bvh {
     }
 
     /// Whether any primitive occludes the ray (see [`crate::accel::Accel::any_hit`]); stops at
-    /// the first occluder. Children are still entered nearer first, which tends to find an
-    /// occluder sooner, and no entry distance is kept: nothing is ever skipped for being far.
+    /// the first occluder. Children are entered farther first along the ray (see the module
+    /// documentation), and no entry distance is kept: nothing is ever skipped for being far.
     #[inline]
     pub fn any_hit_ordered<C: Counters>(
         &self,
@@ -182,10 +188,11 @@ impl Bvh {
                     let t_second = slabs.enter(&self.nodes[second], ray.t_max);
                     match (t_first, t_second) {
                         (Some(_), Some(_)) => {
+                            // The child farther along the ray first (see the module documentation).
                             let (near, far) = if second_first(node, sign) { (second, first) } else { (first, second) };
-                            stack[len] = (far as u32, 0.0);
+                            stack[len] = (near as u32, 0.0);
                             len += 1;
-                            current = near;
+                            current = far;
                             continue;
                         }
                         (Some(_), None) => {

@@ -25,9 +25,9 @@
 //! `2 * radius + 2` merges, and the number of rounds stays logarithmic.
 //!
 //! Greedy merging makes good low levels but weaker high ones: on scanned meshes (the Stanford
-//! bunny) the clustered tree's SAH cost is about 12 % above the full-sweep builder's. Two sweeps
-//! of treelet restructuring ([`super::treelet`], Karras and Aila 2013) bring it within 8 % (see
-//! `docs/bvh.md`); [`Ploc::restructure_passes`] set to 0 gives PLOC alone. PLOC makes one
+//! bunny) the clustered tree's SAH cost is about 10 % above the full-sweep builder's (11 % with a
+//! radius of 16). Two sweeps of treelet restructuring ([`super::treelet`], Karras and Aila 2013)
+//! bring it to 7 % (see `docs/bvh.md`); [`Ploc::restructure_passes`] set to 0 gives PLOC alone. PLOC makes one
 //! primitive per leaf; a final pass ([`super::collapse`]) collapses the subtrees that the SAH says
 //! cost less as a leaf, so that its trees compare with the top-down builders'.
 
