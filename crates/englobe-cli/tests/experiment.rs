@@ -61,6 +61,22 @@ fn seed_experiment_reproduces_the_report_s_reductions() {
         let reduction = 100.0 * (1.0 - seed as f64 / none as f64);
         assert!(reduction >= percent, "test {test}: {reduction:.1} % fewer exact tests, the report {percent} %");
     }
+    // The quality BVHs: fewer nodes visited than the seed's tree on every test, no more exact
+    // tests where the rays meet few spheres (tests 2 and 3), and the reductions they aim at.
+    for kind in [AccelKind::BvhSah, AccelKind::BvhPloc, AccelKind::BvhSweep] {
+        for test in 1..=4 {
+            let (row, seed) = (find(test, kind), find(test, AccelKind::BvhSeedOrdered));
+            assert!(count(row, "nodes_visited") < count(seed, "nodes_visited"), "test {test}: {row} vs {seed}");
+        }
+        for test in [2, 3] {
+            let (row, seed) = (find(test, kind), find(test, AccelKind::BvhSeedOrdered));
+            assert!(count(row, "exact_tests") <= count(seed, "exact_tests"), "test {test}: {row} vs {seed}");
+        }
+        for (test, aim) in [(1, 80.0), (3, 99.5)] {
+            let reduction = find(test, kind)["reduction_percent"].as_f64().unwrap();
+            assert!(reduction >= aim, "test {test}, {kind}: {reduction:.2} % fewer exact tests than none");
+        }
+    }
     // Test 4 in counts: the 8000 spheres out of view cost the seed BVH almost no exact test and
     // brute force 1000 times more.
     let tests = |test, kind| count(find(test, kind), "exact_tests") as f64;

@@ -128,3 +128,47 @@ fn a_thousand_instanced_bunnies_cost_little_more_than_one() {
     // A thousand copies of the bunny's triangles alone would take over a gigabyte.
     assert!(thousand < 200 << 20, "{thousand}");
 }
+
+#[test]
+fn compare_reports_the_quality_of_every_bvh_on_the_dragon() {
+    let dir = tempfile::tempdir().unwrap();
+    let json = dir.path().join("compare.json");
+    let scene = example_scene("dragon", dir.path());
+    let out = englobe(&[
+        "compare",
+        scene.to_str().unwrap(),
+        "--width",
+        "24",
+        "--height",
+        "24",
+        "--accel",
+        "bvh-seed,bvh-sah,bvh-ploc,bvh-sweep",
+        "-q",
+        "--json",
+        json.to_str().unwrap(),
+    ]);
+    let shown = text(&out.stdout);
+    assert!(out.status.success(), "{shown}\n{}", text(&out.stderr));
+    assert!(shown.contains("Quality: SAH cost") && shown.contains("0.5 per interior node"), "{shown}");
+    let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(json).unwrap()).unwrap();
+    assert_eq!(report["sah_constants"]["traversal"].as_f64(), Some(0.5));
+    assert_eq!(report["sah_constants"]["intersection"].as_f64(), Some(1.0));
+    let rows = report["rows"].as_array().unwrap();
+    let row = |name: &str| rows.iter().find(|r| r["accel"] == name).unwrap_or_else(|| panic!("no {name} row"));
+    assert!(row("none")["sah_cost"].is_null());
+    for (name, at_most) in [("bvh-sah", 1.05), ("bvh-ploc", 1.10), ("bvh-sweep", 1.0)] {
+        let r = row(name);
+        let ratio = r["sah_vs_sweep"].as_f64().unwrap();
+        assert!(ratio <= at_most, "{name}: SAH cost {ratio} times the full sweep's");
+        let sizes: Vec<u64> = r["leaf_sizes"].as_array().unwrap().iter().map(|v| v.as_u64().unwrap()).collect();
+        assert_eq!(sizes.len(), 9);
+        assert_eq!(sizes.iter().sum::<u64>(), r["leaves"].as_u64().unwrap(), "{r}");
+        assert_eq!(r["interior_nodes"].as_u64().unwrap() + 1, r["leaves"].as_u64().unwrap(), "a binary tree: {r}");
+        assert!(r["speedup_vs_none"].as_f64().unwrap() > 0.0, "{r}");
+        assert_eq!(r["image_equal"], serde_json::Value::Bool(true));
+    }
+    // The seed's tree: one primitive per leaf, and an SAH cost far above the others.
+    let seed = row("bvh-seed");
+    assert_eq!(seed["leaves"].as_u64(), Some(22_866));
+    assert!(seed["sah_vs_sweep"].as_f64().unwrap() > 10.0, "{seed}");
+}

@@ -1,7 +1,9 @@
 //! Every structure of `AccelKind::ALL` against brute force: the same closest hit (primitive and
 //! `t`) and the same any-hit answer, on random scenes of spheres and triangles and random rays
-//! (axis-parallel ones, rays from inside primitives, rays aimed at primitives, short segments),
-//! and on degenerate inputs. Structures added later are checked here without a line changed.
+//! (axis-parallel ones, rays from inside primitives, rays aimed at primitives and exactly at their
+//! vertices, rays along their edges, rays from points on the faces of their boxes, short
+//! segments), and on degenerate inputs. Structures added later are checked here without a line
+//! changed.
 
 mod common;
 
@@ -48,20 +50,32 @@ fn direction() -> impl Strategy<Value = Vec3> {
     prop_oneof![4 => point(), 2 => axis, 1 => planar].prop_filter("a direction", |d| *d != Vec3::ZERO)
 }
 
-/// How a ray starts: anywhere, at a primitive's centre (inside it, or on a triangle), or aimed at
-/// a primitive's centre from anywhere.
+/// How a ray starts: anywhere, at a primitive's centre (inside it, or on a triangle), aimed at a
+/// primitive's centre from anywhere, aimed exactly at a vertex (of a triangle, or a corner of a
+/// sphere's box), along an edge (the line through two vertices, from before the first), or from a
+/// point on a face of a primitive's box (a face of its leaf's box too: leaves are tight), edges and
+/// corners of the face included.
 #[derive(Clone, Debug)]
 enum Start {
     Free(Vec3, Vec3),
     FromCentre(usize, Vec3),
     AtCentre(usize, Vec3),
+    AtVertex(usize, usize, Vec3),
+    AlongEdge(usize, usize, f32),
+    OnFace(usize, usize, bool, [f32; 2], Vec3),
 }
 
 fn ray_spec() -> impl Strategy<Value = (Start, f32, f32)> {
+    let index = || any::<prop::sample::Index>().prop_map(|i| i.index(usize::MAX));
+    let face_uv = prop_oneof![Just(0.0f32), Just(0.5), Just(1.0), 0.0f32..1.0];
     let start = prop_oneof![
         2 => (point().prop_map(|p| p * 1.5), direction()).prop_map(|(o, d)| Start::Free(o, d)),
-        1 => (any::<prop::sample::Index>(), direction()).prop_map(|(i, d)| Start::FromCentre(i.index(usize::MAX), d)),
-        2 => (any::<prop::sample::Index>(), point().prop_map(|p| p * 1.5)).prop_map(|(i, o)| Start::AtCentre(i.index(usize::MAX), o)),
+        1 => (index(), direction()).prop_map(|(i, d)| Start::FromCentre(i, d)),
+        2 => (index(), point().prop_map(|p| p * 1.5)).prop_map(|(i, o)| Start::AtCentre(i, o)),
+        1 => (index(), 0usize..8, point().prop_map(|p| p * 1.5)).prop_map(|(i, k, o)| Start::AtVertex(i, k, o)),
+        1 => (index(), 0usize..3, prop_oneof![Just(0.0f32), 0.0f32..2.0]).prop_map(|(i, k, b)| Start::AlongEdge(i, k, b)),
+        1 => (index(), 0usize..3, prop::bool::ANY, [face_uv.clone(), face_uv], direction())
+            .prop_map(|(i, axis, max, uv, d)| Start::OnFace(i, axis, max, uv, d)),
     ];
     let range = prop_oneof![
         4 => Just((0.0f32, f32::INFINITY)),
@@ -70,14 +84,48 @@ fn ray_spec() -> impl Strategy<Value = (Start, f32, f32)> {
     (start, range).prop_map(|(s, (t0, t1))| (s, t0, t1))
 }
 
+/// The vertices of a shape: a triangle's three, or the eight corners of another shape's box.
+fn vertices(shape: &Shape) -> Vec<Vec3> {
+    match shape {
+        Shape::Triangle(t) => t.vertices.to_vec(),
+        s => {
+            let b = s.bounds();
+            (0..8)
+                .map(|k| {
+                    Vec3::new([b.min.x, b.max.x][k & 1], [b.min.y, b.max.y][k >> 1 & 1], [b.min.z, b.max.z][k >> 2])
+                })
+                .collect()
+        }
+    }
+}
+
 fn make_ray(shapes: &[Shape], (start, t_min, t_max): &(Start, f32, f32)) -> Ray {
-    let centre = |i: usize| shapes[i % shapes.len().max(1)].bounds().center();
+    let n = shapes.len().max(1);
+    let centre = |i: usize| shapes[i % n].bounds().center();
+    let vertex = |i: usize, k: usize| {
+        let v = vertices(&shapes[i % n]);
+        v[k % v.len()]
+    };
     let (origin, dir) = match *start {
+        _ if shapes.is_empty() => (Vec3::ZERO, Vec3::Z),
         Start::Free(o, d) => (o, d),
-        Start::FromCentre(i, d) if !shapes.is_empty() => (centre(i), d),
-        Start::AtCentre(i, o) if !shapes.is_empty() && centre(i) != o => (o, centre(i) - o),
-        Start::FromCentre(_, d) => (Vec3::ZERO, d),
+        Start::FromCentre(i, d) => (centre(i), d),
+        Start::AtCentre(i, o) if centre(i) != o => (o, centre(i) - o),
         Start::AtCentre(_, o) => (o, Vec3::Z),
+        Start::AtVertex(i, k, o) if vertex(i, k) != o => (o, vertex(i, k) - o),
+        Start::AtVertex(_, _, o) => (o, Vec3::Z),
+        Start::AlongEdge(i, k, back) => {
+            let (a, b) = (vertex(i, k), vertex(i, k + 1));
+            if a == b { (a, Vec3::X) } else { (a - (b - a) * back, b - a) }
+        }
+        Start::OnFace(i, axis, max, [u, v], d) => {
+            let b = shapes[i % n].bounds();
+            let mut o = b.min + (b.max - b.min) * Vec3::new(u, v, u);
+            o[(axis + 1) % 3] = b.min[(axis + 1) % 3] + (b.max - b.min)[(axis + 1) % 3] * u;
+            o[(axis + 2) % 3] = b.min[(axis + 2) % 3] + (b.max - b.min)[(axis + 2) % 3] * v;
+            o[axis] = if max { b.max[axis] } else { b.min[axis] };
+            (o, d)
+        }
     };
     Ray::segment(origin, dir, *t_min, *t_max)
 }

@@ -1,10 +1,13 @@
 //! Every structure of `AccelKind::ALL` against brute force on real meshes from the shared data
 //! folder (the Stanford bunny, the Utah teapot): valid trees, the same closest hit and any-hit
-//! answer for rays from all around, and less work than brute force.
+//! answer for rays from all around, and less work than brute force. Then the quality of the
+//! trees on the bunny and the Sponza atrium: the SAH costs of the builders against the full
+//! sweep's, which the documentation quotes.
 
 mod common;
 
 use common::{check_all_structures, shared_dir};
+use englobe::accel::validate::validate_bvh;
 use englobe::{Aabb, Accel, AccelKind, AnyAccel, NoCount, Ray, TriangleMesh, Vec3, WorkCounts};
 
 fn load_obj(relative: &str) -> TriangleMesh {
@@ -73,6 +76,17 @@ fn check_mesh(relative: &str, rays: usize) {
     let (none, seed, ordered) = (tests(AccelKind::None), tests(AccelKind::BvhSeed), tests(AccelKind::BvhSeedOrdered));
     assert_eq!(none, (mesh.len() * rays.len()) as u64);
     assert!(ordered < seed && seed * 10 < none, "{relative}: exact tests none {none}, seed {seed}, ordered {ordered}");
+    // The SAH trees visit a small fraction of the seed tree's nodes.
+    let visits = |kind| {
+        let accel = AnyAccel::build(kind, &boxes);
+        let mut c = WorkCounts::default();
+        for r in &rays {
+            accel.closest_hit(r, &mut c, |i, r| mesh.intersect(i, r));
+        }
+        c.nodes_visited
+    };
+    let (seed_visits, sah_visits) = (visits(AccelKind::BvhSeedOrdered), visits(AccelKind::BvhSah));
+    assert!(sah_visits * 10 < seed_visits, "{relative}: nodes visited: bvh-sah {sah_visits}, seed {seed_visits}");
     // The rays do hit the mesh, often enough for the comparison to mean something.
     let bvh = AnyAccel::build(AccelKind::BvhSeedOrdered, &boxes);
     let hits = rays.iter().filter(|r| bvh.closest_hit(r, &mut NoCount, |i, r| mesh.intersect(i, r)).is_some()).count();
@@ -87,4 +101,24 @@ fn stanford_bunny() {
 #[test]
 fn utah_teapot() {
     check_mesh("scenes/meshes/teapot/teapot.obj", 600);
+}
+
+/// SAH costs of bvh-sah, bvh-ploc and bvh-sweep on a mesh, and the seed tree's.
+fn sah_costs(relative: &str) -> [f32; 4] {
+    let mesh = load_obj(relative);
+    let boxes: Vec<Aabb> = (0..mesh.len() as u32).map(|t| mesh.triangle_bounds(t)).collect();
+    [AccelKind::BvhSah, AccelKind::BvhPloc, AccelKind::BvhSweep, AccelKind::BvhSeed].map(|kind| {
+        let accel = AnyAccel::build(kind, &boxes);
+        validate_bvh(accel.bvh().unwrap(), &boxes).unwrap_or_else(|e| panic!("{relative}, {kind}: {e}")).sah_cost
+    })
+}
+
+#[test]
+fn binned_sah_is_within_5_percent_and_ploc_within_10_percent_of_the_full_sweep() {
+    for relative in ["scenes/meshes/bunny/stanford-bunny.obj", "scenes/meshes/sponza-dabrovic/sponza.obj"] {
+        let [sah, ploc, sweep, seed] = sah_costs(relative);
+        assert!(sah <= sweep * 1.05, "{relative}: bvh-sah {sah}, bvh-sweep {sweep}");
+        assert!(ploc <= sweep * 1.10, "{relative}: bvh-ploc {ploc}, bvh-sweep {sweep}");
+        assert!(sweep * 50.0 < seed, "{relative}: bvh-sweep {sweep}, bvh-seed {seed}");
+    }
 }

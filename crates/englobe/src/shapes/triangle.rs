@@ -110,6 +110,13 @@ pub fn intersect_triangle(ray: &Ray, w: &WatertightRay, v0: Vec3, v1: Vec3, v2: 
     if (e0 < 0.0 || e1 < 0.0 || e2 < 0.0) && (e0 > 0.0 || e1 > 0.0 || e2 > 0.0) {
         return None;
     }
+    // A zero-area triangle is never hit. Its sheared vertices are rounded, so its edge functions
+    // need not cancel exactly and a tiny determinant would give a `t` anywhere along the ray, even
+    // outside the triangle's box: the test is made on the vertices themselves, as pbrt-v4 does
+    // (only for rays that passed the edge test, so it costs almost nothing).
+    if (v1 - v0).cross(v2 - v0) == Vec3::ZERO {
+        return None;
+    }
     let det = e0 + e1 + e2;
     let t_scaled = e0 * az + e1 * bz + e2 * cz;
     let inv_det = 1.0 / det;
@@ -266,6 +273,15 @@ mod tests {
         }
         assert_eq!(flat.double_area(), 0.0);
         assert!(flat.is_degenerate() && point.is_degenerate() && !tri().is_degenerate());
+        // Collinear along z, aimed at the middle from afar: the sheared edge functions do not
+        // cancel exactly, and the hit they would give lies off the segment, outside its box.
+        let on_z = Triangle::new(
+            Vec3::new(0.0, 0.0, 8.786655),
+            Vec3::new(0.0, 0.0, 5.2886734),
+            Vec3::new(0.0, 0.0, 6.1506586),
+        );
+        let from = Vec3::new(11.242288, -3.151279, -10.5479765);
+        assert!(on_z.intersect(&Ray::new(from, on_z.bounds().center() - from)).is_none());
     }
 
     #[test]

@@ -35,6 +35,7 @@ use std::cell::Cell;
 use super::slab::RaySlabs;
 use super::{Bvh, BvhNode, SECOND_IS_LOWER};
 use crate::Ray;
+use crate::aabb::ROBUST_FAR_SCALE;
 use crate::accel::{Counters, Hit, HitRecord};
 use crate::shapes::PrimHit;
 
@@ -44,6 +45,19 @@ pub const INLINE_STACK: usize = 64;
 
 /// A pending subtree: its node and the distance at which the ray enters its box.
 type Pending = (u32, f32);
+
+/// How far along the ray a box may begin and still be entered, for a query whose closest hit so
+/// far is at `t_max`: a little beyond it, by the rounding bound of the slab test
+/// ([`ROBUST_FAR_SCALE`]). A primitive hit exactly where the ray meets its box (through a vertex or
+/// an edge on a face of the box) can compute a `t` a few units in the last place below the box's
+/// computed entry; without the margin the box would be dropped, and a primitive of lower index
+/// hit at that same `t` would lose the tie to one found before it. Boxes entered within the
+/// margin cost a few more exact tests, never a wrong answer: a primitive's own test still honours
+/// `t_max`.
+#[inline(always)]
+fn reach(t_max: f32) -> f32 {
+    t_max + t_max.abs() * (ROBUST_FAR_SCALE - 1.0)
+}
 
 /// Whether a ray going down the axes of `negative_bits` should enter the interior `node`'s second
 /// child first: the one on the lower side of the node's axis if the ray goes up that axis, the
@@ -93,7 +107,7 @@ impl Bvh {
         let sign = slabs.negative_bits();
         let mut record = HitRecord::new(*ray);
         counters.box_tests(1);
-        slabs.enter(&self.nodes[0], record.ray.t_max)?;
+        slabs.enter(&self.nodes[0], reach(record.ray.t_max))?;
         self.with_stack(|stack| {
             let mut len = 0usize;
             let mut current = 0usize;
@@ -110,8 +124,9 @@ impl Bvh {
                 } else {
                     let (first, second) = (current + 1, node.index as usize);
                     counters.box_tests(2);
-                    let t_first = slabs.enter(&self.nodes[first], record.ray.t_max);
-                    let t_second = slabs.enter(&self.nodes[second], record.ray.t_max);
+                    let limit = reach(record.ray.t_max);
+                    let t_first = slabs.enter(&self.nodes[first], limit);
+                    let t_second = slabs.enter(&self.nodes[second], limit);
                     match (t_first, t_second) {
                         (Some(a), Some(b)) => {
                             let (near, far, t_far) =
@@ -139,8 +154,8 @@ impl Bvh {
                     }
                     len -= 1;
                     let (node, t_enter) = stack[len];
-                    // Entry at exactly `t_max` is kept: a primitive there may win the tie by index.
-                    if t_enter <= record.ray.t_max {
+                    // Entry at `t_max` is kept: a primitive there may win the tie by index.
+                    if t_enter <= reach(record.ray.t_max) {
                         current = node as usize;
                         break;
                     }
@@ -164,8 +179,9 @@ impl Bvh {
         }
         let slabs = RaySlabs::new(ray);
         let sign = slabs.negative_bits();
+        let limit = reach(ray.t_max);
         counters.box_tests(1);
-        if slabs.enter(&self.nodes[0], ray.t_max).is_none() {
+        if slabs.enter(&self.nodes[0], limit).is_none() {
             return false;
         }
         self.with_stack(|stack| {
@@ -184,8 +200,8 @@ impl Bvh {
                 } else {
                     let (first, second) = (current + 1, node.index as usize);
                     counters.box_tests(2);
-                    let t_first = slabs.enter(&self.nodes[first], ray.t_max);
-                    let t_second = slabs.enter(&self.nodes[second], ray.t_max);
+                    let t_first = slabs.enter(&self.nodes[first], limit);
+                    let t_second = slabs.enter(&self.nodes[second], limit);
                     match (t_first, t_second) {
                         (Some(_), Some(_)) => {
                             // The child farther along the ray first (see the module documentation).
