@@ -13,7 +13,7 @@ use englobe_render::write_image;
 use englobe_scene::parse_scene;
 use serde::Serialize;
 
-use crate::measure::{RenderSettings, build, compare_films, render, thread_pool};
+use crate::measure::{MAX_TIMED_RUNS, MIN_TIMED_SECONDS, RenderSettings, build, compare_films, render, thread_pool};
 use crate::render_cmd::parse_accel;
 use crate::report::{grouped, write_json};
 use crate::seed_report::{ReportFigures, SEED_TESTS};
@@ -53,11 +53,6 @@ pub struct ExperimentArgs {
     #[arg(short, long)]
     quiet: bool,
 }
-
-/// Renders are repeated until they have taken this long in all (or [`MAX_TIMED_RUNS`] times).
-const MIN_TIMED_SECONDS: f64 = 2.0;
-/// Most renders timed per test and accelerator.
-const MAX_TIMED_RUNS: u32 = 10;
 
 /// One line of the table: one test rendered with one accelerator.
 #[derive(Clone, Debug, Serialize)]

@@ -8,6 +8,12 @@ use englobe::{AccelKind, World};
 use englobe_render::{Film, RenderOutput, Renderer, build_world};
 use englobe_scene::Scene;
 
+/// Renders are repeated until they have taken this long in all (or [`MAX_TIMED_RUNS`] times), and
+/// the best time is kept.
+pub const MIN_TIMED_SECONDS: f64 = 2.0;
+/// Most renders timed per structure (and test).
+pub const MAX_TIMED_RUNS: u32 = 10;
+
 /// How to render.
 #[derive(Clone, Copy, Debug)]
 pub struct RenderSettings {
