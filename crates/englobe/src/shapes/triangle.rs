@@ -308,6 +308,7 @@ mod tests {
         assert!(on_z.intersect(&Ray::new(from, on_z.bounds().center() - from)).is_none());
     }
 
+    #[test]
     fn a_sliver_s_hit_lies_in_its_box() {
         // A triangle of the Sponza atrium, 10.8 long and 0.01 wide, seen at a glancing angle: the
         // edge functions alone put the hit 1.4e-4 before the ray enters the triangle's box.
@@ -324,7 +325,6 @@ mod tests {
         assert!(sliver.intersect(&ray.with_range(0.0, enter * 0.999_999)).is_none());
         assert_eq!(sliver.intersect(&ray.with_range(0.0, hit.t)).map(|h| h.t), Some(hit.t));
     }
-
 
     #[test]
     fn needles_and_slivers_never_give_nan() {
