@@ -46,6 +46,8 @@ fn stats_table_and_json() {
             "--stats",
             "--stats-json",
             "s.json",
+            "--accel",
+            "none",
             "-o",
             "a.png",
         ],

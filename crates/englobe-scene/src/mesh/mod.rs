@@ -1,6 +1,6 @@
 //! Mesh files: OBJ (+ MTL) through `tobj`, PLY with englobe's own parser, glTF 2.0 with the
 //! `gltf` crate's JSON model. Every loader is wrapped in englobe's own checks (see each module and
-//! [`build`]): a bad file is refused with an error naming the file and the line, byte or JSON path,
+//! `build.rs`): a bad file is refused with an error naming the file and the line, byte or JSON path,
 //! sizes are checked against the file before anything is allocated, and nothing here panics on a
 //! file.
 

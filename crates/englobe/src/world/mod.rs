@@ -5,7 +5,7 @@
 //! Every bounded primitive (a sphere, a box, one triangle of a mesh, one whole instance) gets an
 //! index in the order the objects were given, and the structure is built over their boxes.
 //! Unbounded shapes (planes) stay outside the structure and are tested beside it, as the design of
-//! every production ray tracer does. Instances make a two-level hierarchy: see [`instances`].
+//! every production ray tracer does. Instances make a two-level hierarchy: see [`BottomLevel`].
 
 use std::sync::Arc;
 
