@@ -105,6 +105,8 @@ pub fn run(args: ExperimentArgs) -> anyhow::Result<ExitCode> {
     if !kinds.contains(&AccelKind::None) {
         kinds.insert(0, AccelKind::None);
     }
+    // The yardstick row: the fewest exact tests any BVH over the same spheres could make.
+    kinds.push(AccelKind::Bound);
     if let Some(dir) = &args.images {
         std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     }
@@ -338,6 +340,27 @@ fn seed_checks(rows: &[Row]) -> Vec<Check> {
                 });
             }
         }
+    }
+    // Every BVH against the fewest exact tests any BVH could make (the `bound` row).
+    for test in SEED_TESTS {
+        let Some(bound) = find(test.number, AccelKind::Bound) else { continue };
+        let above: Vec<String> = rows
+            .iter()
+            .filter(|r| r.test == test.number && r.accel.starts_with("bvh"))
+            .map(|r| format!("{} +{:.1} %", r.accel, 100.0 * (r.exact_tests as f64 / bound.exact_tests as f64 - 1.0)))
+            .collect();
+        checks.push(Check {
+            claim: format!(
+                "test {}: no BVH makes fewer exact tests than the bound, {}; above it: {}",
+                test.number,
+                grouped(bound.exact_tests),
+                above.join(", ")
+            ),
+            holds: rows
+                .iter()
+                .filter(|r| r.test == test.number && r.accel.starts_with("bvh"))
+                .all(|r| r.exact_tests >= bound.exact_tests),
+        });
     }
     checks.push(Check {
         claim: "every accelerator draws the same image as brute force on every test".to_owned(),

@@ -36,7 +36,8 @@ fn seed_experiment_reproduces_the_report_s_reductions() {
 
     let report: Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
     let rows = rows(&report);
-    assert_eq!(rows.len(), 4 * AccelKind::ALL.len());
+    // Every structure, plus the bound row: the fewest exact tests any BVH could make.
+    assert_eq!(rows.len(), 4 * (AccelKind::ALL.len() + 1));
     let find = |test: u64, accel: AccelKind| {
         rows.iter()
             .find(|r| r["test"].as_u64() == Some(test) && r["accel"].as_str() == Some(accel.name()))
@@ -49,6 +50,10 @@ fn seed_experiment_reproduces_the_report_s_reductions() {
             assert_eq!(row["image_identical"], Value::Bool(true), "test {test}, {kind}: {row}");
             assert_eq!(count(row, "rays"), count(none, "rays"), "test {test}, {kind}: same image, same rays");
             assert!(row["seconds"].as_f64().is_some());
+        }
+        let bound = count(find(test, AccelKind::Bound), "exact_tests");
+        for &kind in AccelKind::ALL.iter().filter(|k| k.name().starts_with("bvh")) {
+            assert!(count(find(test, kind), "exact_tests") >= bound, "test {test}: {kind} below the bound {bound}");
         }
         // The ordered traversal tests fewer primitives than the report's on every test.
         let (seed, ordered) = (find(test, AccelKind::BvhSeed), find(test, AccelKind::BvhSeedOrdered));

@@ -9,6 +9,7 @@
 //! * [`bvh`]: the canonical binary BVH, its builders and traversals.
 //! * [`validate`]: the invariants of a BVH, checked, and its quality, measured.
 
+pub mod bound;
 pub mod brute;
 pub mod bvh;
 pub mod counters;
@@ -17,6 +18,7 @@ pub mod validate;
 use std::fmt;
 use std::str::FromStr;
 
+pub use bound::LowerBound;
 pub use brute::BruteForce;
 pub use bvh::{BinnedSah, Bvh, CandidateListBvh, Ploc, SeedPairing, SweepSah};
 pub use counters::{Counters, NoCount, WorkCounts};
@@ -140,6 +142,9 @@ pub enum AccelKind {
     BvhPloc,
     /// A [`Bvh`] built top-down with the full-sweep surface area heuristic ([`SweepSah`]).
     BvhSweep,
+    /// Not a structure: the fewest exact tests any BVH over the same boxes could make
+    /// ([`LowerBound`]), a yardstick for the others. Not in [`AccelKind::ALL`].
+    Bound,
 }
 
 impl AccelKind {
@@ -153,6 +158,10 @@ impl AccelKind {
         AccelKind::BvhSweep,
     ];
 
+    /// Yardsticks that answer like brute force and count what the structures are measured
+    /// against; named on the command line but not built by `compare` and the like.
+    pub const REFERENCES: &'static [AccelKind] = &[AccelKind::Bound];
+
     /// The name used on the command line and in tables.
     pub fn name(self) -> &'static str {
         match self {
@@ -162,6 +171,7 @@ impl AccelKind {
             AccelKind::BvhSah => "bvh-sah",
             AccelKind::BvhPloc => "bvh-ploc",
             AccelKind::BvhSweep => "bvh-sweep",
+            AccelKind::Bound => "bound",
         }
     }
 
@@ -181,6 +191,9 @@ impl AccelKind {
             }
             AccelKind::BvhSweep => {
                 "binary BVH built top-down with the full-sweep surface area heuristic (the quality reference)"
+            }
+            AccelKind::Bound => {
+                "not a structure: the fewest exact tests any BVH over the primitives' boxes could make (answers by brute force)"
             }
         }
     }
@@ -203,7 +216,12 @@ pub struct UnknownAccel {
 impl FromStr for AccelKind {
     type Err = UnknownAccel;
     fn from_str(s: &str) -> Result<Self, Self::Err> {
-        AccelKind::ALL.iter().copied().find(|k| k.name() == s).ok_or_else(|| UnknownAccel { given: s.to_owned() })
+        AccelKind::ALL
+            .iter()
+            .chain(AccelKind::REFERENCES)
+            .copied()
+            .find(|k| k.name() == s)
+            .ok_or_else(|| UnknownAccel { given: s.to_owned() })
     }
 }
 
@@ -223,6 +241,8 @@ pub enum AnyAccel {
     BvhPloc(Bvh),
     /// See [`AccelKind::BvhSweep`].
     BvhSweep(Bvh),
+    /// See [`AccelKind::Bound`].
+    Bound(LowerBound),
 }
 
 impl AnyAccel {
@@ -235,13 +255,14 @@ impl AnyAccel {
             AccelKind::BvhSah => AnyAccel::BvhSah(BinnedSah::default().build(boxes)),
             AccelKind::BvhPloc => AnyAccel::BvhPloc(Ploc::default().build(boxes)),
             AccelKind::BvhSweep => AnyAccel::BvhSweep(SweepSah::default().build(boxes)),
+            AccelKind::Bound => AnyAccel::Bound(LowerBound::build(boxes)),
         }
     }
 
     /// The BVH behind the structure, if it is one (for validation and statistics).
     pub fn bvh(&self) -> Option<&Bvh> {
         match self {
-            AnyAccel::BruteForce(_) => None,
+            AnyAccel::BruteForce(_) | AnyAccel::Bound(_) => None,
             AnyAccel::BvhSeed(a) => Some(a.bvh()),
             AnyAccel::BvhSeedOrdered(a) | AnyAccel::BvhSah(a) | AnyAccel::BvhPloc(a) | AnyAccel::BvhSweep(a) => Some(a),
         }
@@ -257,6 +278,7 @@ macro_rules! dispatch_accel {
             AnyAccel::BvhSah($a) => $e,
             AnyAccel::BvhPloc($a) => $e,
             AnyAccel::BvhSweep($a) => $e,
+            AnyAccel::Bound($a) => $e,
         }
     };
 }
@@ -292,7 +314,7 @@ mod tests {
 
     #[test]
     fn names_round_trip() {
-        for &k in AccelKind::ALL {
+        for &k in AccelKind::ALL.iter().chain(AccelKind::REFERENCES) {
             assert_eq!(k.name().parse::<AccelKind>().unwrap(), k);
         }
         let err = "octree".parse::<AccelKind>().unwrap_err();
