@@ -7,12 +7,18 @@
 //!
 //! * [`brute`]: no structure; the oracle every other one is checked against.
 //! * [`bvh`]: the canonical binary BVH, its builders and traversals.
+//! * [`kdtree`]: the SAH kd-tree, built in O(N log N) with split clipping.
+//! * [`grid`]: the uniform grid, traversed with a 3D-DDA.
+//! * [`mailbox`]: what spares the spatial subdivisions a second test of the same primitive.
 //! * [`validate`]: the invariants of a BVH, checked, and its quality, measured.
 
 pub mod bound;
 pub mod brute;
 pub mod bvh;
 pub mod counters;
+pub mod grid;
+pub mod kdtree;
+pub mod mailbox;
 pub mod validate;
 
 use std::fmt;
@@ -22,6 +28,8 @@ pub use bound::LowerBound;
 pub use brute::BruteForce;
 pub use bvh::{BinnedSah, Bvh, CandidateListBvh, Ploc, SeedPairing, SweepSah};
 pub use counters::{Counters, NoCount, WorkCounts};
+pub use grid::{Grid, GridParams};
+pub use kdtree::{ClipFn, KdTree, KdTreeParams};
 
 use crate::shapes::PrimHit;
 use crate::{Aabb, Ray};
@@ -145,6 +153,10 @@ pub enum AccelKind {
     /// Not a structure: the fewest exact tests any BVH over the same boxes could make
     /// ([`LowerBound`]), a yardstick for the others. Not in [`AccelKind::ALL`].
     Bound,
+    /// The SAH kd-tree ([`KdTree`]).
+    KdTree,
+    /// The uniform grid ([`Grid`]).
+    Grid,
 }
 
 impl AccelKind {
@@ -156,6 +168,8 @@ impl AccelKind {
         AccelKind::BvhSah,
         AccelKind::BvhPloc,
         AccelKind::BvhSweep,
+        AccelKind::KdTree,
+        AccelKind::Grid,
     ];
 
     /// Yardsticks that answer like brute force and count what the structures are measured
@@ -172,6 +186,8 @@ impl AccelKind {
             AccelKind::BvhPloc => "bvh-ploc",
             AccelKind::BvhSweep => "bvh-sweep",
             AccelKind::Bound => "bound",
+            AccelKind::KdTree => "kdtree",
+            AccelKind::Grid => "grid",
         }
     }
 
@@ -195,6 +211,10 @@ impl AccelKind {
             AccelKind::Bound => {
                 "not a structure: the fewest exact tests any BVH over the primitives' boxes could make (answers by brute force)"
             }
+            AccelKind::KdTree => {
+                "SAH kd-tree built in O(N log N) with split clipping, traversed front to back with mailboxing"
+            }
+            AccelKind::Grid => "uniform grid of about 8 cells per primitive, traversed with the 3D-DDA and mailboxing",
         }
     }
 }
@@ -243,12 +263,25 @@ pub enum AnyAccel {
     BvhSweep(Bvh),
     /// See [`AccelKind::Bound`].
     Bound(LowerBound),
+    /// See [`AccelKind::KdTree`].
+    KdTree(KdTree),
+    /// See [`AccelKind::Grid`].
+    Grid(Grid),
 }
 
 impl AnyAccel {
     /// Builds the structure `kind` over the primitives' boxes (at most [`MAX_PRIMITIVES`]).
     pub fn build(kind: AccelKind, boxes: &[Aabb]) -> Self {
+        Self::build_with_clipper(kind, boxes, &|prim, cell| boxes[prim as usize].intersection(cell))
+    }
+
+    /// Builds the structure `kind`; structures that split primitives across cells (the kd-tree)
+    /// ask `clip(prim, cell)` for the box of the part of primitive `prim` inside `cell`, which can
+    /// be much tighter than the box's part (see [`crate::shapes::clip_triangle`]).
+    pub fn build_with_clipper(kind: AccelKind, boxes: &[Aabb], clip: ClipFn<'_>) -> Self {
         match kind {
+            AccelKind::KdTree => AnyAccel::KdTree(KdTree::build_with_clipper(boxes, clip, KdTreeParams::default())),
+            AccelKind::Grid => AnyAccel::Grid(Grid::build(boxes)),
             AccelKind::None => AnyAccel::BruteForce(BruteForce::build(boxes)),
             AccelKind::BvhSeed => AnyAccel::BvhSeed(CandidateListBvh::build(boxes)),
             AccelKind::BvhSeedOrdered => AnyAccel::BvhSeedOrdered(SeedPairing::build(boxes)),
@@ -265,7 +298,18 @@ impl AnyAccel {
             AnyAccel::BruteForce(_) | AnyAccel::Bound(_) => None,
             AnyAccel::BvhSeed(a) => Some(a.bvh()),
             AnyAccel::BvhSeedOrdered(a) | AnyAccel::BvhSah(a) | AnyAccel::BvhPloc(a) | AnyAccel::BvhSweep(a) => Some(a),
+            AnyAccel::KdTree(_) | AnyAccel::Grid(_) => None,
         }
+    }
+
+    /// The kd-tree behind the structure, if it is one.
+    pub fn kdtree(&self) -> Option<&KdTree> {
+        if let AnyAccel::KdTree(t) = self { Some(t) } else { None }
+    }
+
+    /// The grid behind the structure, if it is one.
+    pub fn grid(&self) -> Option<&Grid> {
+        if let AnyAccel::Grid(g) = self { Some(g) } else { None }
     }
 }
 
@@ -279,6 +323,8 @@ macro_rules! dispatch_accel {
             AnyAccel::BvhPloc($a) => $e,
             AnyAccel::BvhSweep($a) => $e,
             AnyAccel::Bound($a) => $e,
+            AnyAccel::KdTree($a) => $e,
+            AnyAccel::Grid($a) => $e,
         }
     };
 }

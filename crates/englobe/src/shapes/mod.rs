@@ -3,6 +3,7 @@
 //! of meshes.
 
 mod aabox;
+mod clip;
 mod instance;
 mod mesh;
 mod plane;
@@ -10,6 +11,7 @@ mod sphere;
 mod triangle;
 
 pub use aabox::AaBox;
+pub use clip::clip_triangle;
 pub use instance::{Instance, InstanceError, transform_box};
 pub use mesh::{MeshError, TriangleMesh};
 pub use plane::Plane;

@@ -1,21 +1,37 @@
 //! Shared by the cross-structure tests: one check that runs every structure of
-//! [`AccelKind::ALL`] against brute force, and the shared data folder.
+//! [`AccelKind::ALL`] against brute force (the kd-tree both with the caller's clipping and with
+//! plain boxes), and the shared data folder.
 
 #![allow(dead_code)]
 
 use std::path::PathBuf;
 
+use englobe::accel::ClipFn;
+use englobe::accel::grid::stats::validate_grid;
+use englobe::accel::kdtree::stats::validate_kdtree;
 use englobe::accel::validate::validate_bvh;
 use englobe::{Aabb, Accel, AccelKind, AnyAccel, Hit, NoCount, PrimHit, Ray, WorkCounts};
 
 /// Relative tolerance on the closest hit's `t`.
 pub const T_TOLERANCE: f32 = 1e-6;
 
-/// Builds every structure over `boxes`, validates the BVHs, and checks that each one gives the
-/// same closest hit (same primitive, `t` within [`T_TOLERANCE`] relative) and the same any-hit
-/// answer as brute force for every ray, with counting on and off. Returns the first disagreement.
+/// Builds every structure over `boxes`, validates the trees and grids, and checks that each one
+/// gives the same closest hit (same primitive, `t` within [`T_TOLERANCE`] relative) and the same
+/// any-hit answer as brute force for every ray, with counting on and off. Returns the first
+/// disagreement.
 pub fn check_all_structures(
     boxes: &[Aabb],
+    rays: &[Ray],
+    intersect: impl Fn(u32, &Ray) -> Option<PrimHit> + Copy,
+) -> Result<(), String> {
+    check_all_structures_clipped(boxes, &|p, c| boxes[p as usize].intersection(c), rays, intersect)
+}
+
+/// [`check_all_structures`] with the structures that clip primitives to cells (the kd-tree) built
+/// with `clip`, and once more with plain box clipping.
+pub fn check_all_structures_clipped(
+    boxes: &[Aabb],
+    clip: ClipFn<'_>,
     rays: &[Ray],
     intersect: impl Fn(u32, &Ray) -> Option<PrimHit> + Copy,
 ) -> Result<(), String> {
@@ -29,10 +45,18 @@ pub fn check_all_structures(
             )
         })
         .collect();
-    for &kind in AccelKind::ALL {
-        let accel = AnyAccel::build(kind, boxes);
+    let mut builds: Vec<(String, AnyAccel)> =
+        AccelKind::ALL.iter().map(|&k| (k.to_string(), AnyAccel::build_with_clipper(k, boxes, clip))).collect();
+    builds.push(("kdtree with box clipping".to_owned(), AnyAccel::build(AccelKind::KdTree, boxes)));
+    for (kind, accel) in &builds {
         if let Some(bvh) = accel.bvh() {
             validate_bvh(bvh, boxes).map_err(|e| format!("{kind}: invalid tree: {e}"))?;
+        }
+        if let Some(tree) = accel.kdtree() {
+            validate_kdtree(tree, boxes).map_err(|e| format!("{kind}: invalid tree: {e}"))?;
+        }
+        if let Some(grid) = accel.grid() {
+            validate_grid(grid, boxes).map_err(|e| format!("{kind}: invalid grid: {e}"))?;
         }
         for (ray, &(closest, any)) in rays.iter().zip(&expected) {
             let got = accel.closest_hit(ray, &mut NoCount, intersect);
