@@ -15,7 +15,7 @@ use std::sync::Arc;
 
 use super::{Object, World};
 use crate::accel::{Accel, AccelKind, AnyAccel, Counters, Hit, StructureStats};
-use crate::shapes::{Instance, TriangleMesh, WatertightRay};
+use crate::shapes::{Instance, TriangleMesh, WatertightRay, clip_triangle};
 
 /// A structure over the triangles of one mesh, in the mesh's own space.
 #[derive(Clone, Debug)]
@@ -28,7 +28,9 @@ impl BottomLevel {
     /// The structure `kind` over the triangles of `mesh`.
     pub fn build(mesh: Arc<TriangleMesh>, kind: AccelKind) -> Self {
         let boxes: Vec<_> = (0..mesh.len() as u32).map(|t| mesh.triangle_bounds(t)).collect();
-        BottomLevel { accel: AnyAccel::build(kind, &boxes), mesh }
+        let clip = |t: u32, cell: &crate::Aabb| clip_triangle(mesh.triangle(t).vertices, cell);
+        let accel = AnyAccel::build_with_clipper(kind, &boxes, &clip);
+        BottomLevel { accel, mesh }
     }
 
     /// The mesh.

@@ -6,6 +6,8 @@
 //! index in the order the objects were given, and the structure is built over their boxes.
 //! Unbounded shapes (planes) stay outside the structure and are tested beside it, as the design of
 //! every production ray tracer does. Instances make a two-level hierarchy: see [`BottomLevel`].
+//! Structures that split primitives across cells (the kd-tree) get each triangle's exact part in a
+//! cell ([`clip_triangle`]), and the box's part for other shapes.
 
 use std::sync::Arc;
 
@@ -14,7 +16,7 @@ use glam::Vec3;
 mod instances;
 
 use crate::accel::{Accel, AccelKind, AnyAccel, Counters, HitRecord, MAX_PRIMITIVES, StructureStats};
-use crate::shapes::{Bounded, Instance, Intersect, PrimHit, Shape, TriangleMesh, WatertightRay};
+use crate::shapes::{Bounded, Instance, Intersect, PrimHit, Shape, TriangleMesh, WatertightRay, clip_triangle};
 use crate::{Aabb, Ray};
 
 pub use instances::BottomLevel;
@@ -161,7 +163,16 @@ impl World {
                 }
             }
         }
-        let accel = AnyAccel::build(kind, &boxes);
+        // Split clipping: a triangle's exact part in a cell, any other shape's box's part.
+        let clip = |prim: u32, cell: &Aabb| {
+            let object = prim_object[prim as usize];
+            match &objects[object as usize] {
+                Object::Mesh(m) => clip_triangle(m.triangle(prim - object_first_prim[object as usize]).vertices, cell),
+                Object::Shape(Shape::Triangle(t)) => clip_triangle(t.vertices, cell),
+                _ => boxes[prim as usize].intersection(cell),
+            }
+        };
+        let accel = AnyAccel::build_with_clipper(kind, &boxes, &clip);
         drop(boxes);
         let (bottom, object_bottom) = instances::build_bottom_levels(&objects, kind);
         Ok(World { objects, prim_object, object_first_prim, unbounded, accel, kind, bottom, object_bottom })

@@ -1,0 +1,129 @@
+//! What the kd-tree's and the grid's choices are worth, in work per ray on real meshes: the SAH
+//! costs and the empty space bonus of the kd-tree, exact triangle clipping against box clipping,
+//! mailboxing on and off, and the grid's density `lambda`. Figures, not checks: ignored by default,
+//! printed by
+//!
+//! ```sh
+//! cargo test --release -p englobe --test accel_ablation -- --ignored --nocapture
+//! ```
+//!
+//! (`docs/accelerators.md` quotes them). Rays come from a sphere around each mesh towards random
+//! points of its box, so about half of them hit it.
+
+mod common;
+
+use common::shared_dir;
+use englobe::accel::grid::stats::validate_grid;
+use englobe::accel::kdtree::stats::validate_kdtree;
+use englobe::accel::{Grid, GridParams, KdTree, KdTreeParams};
+use englobe::shapes::clip_triangle;
+use englobe::{Aabb, Accel, AccelKind, AnyAccel, Ray, TriangleMesh, Vec3, WorkCounts};
+
+fn load_obj(relative: &str) -> TriangleMesh {
+    let path = shared_dir().join(relative);
+    let (models, _) = tobj::load_obj(&path, &tobj::GPU_LOAD_OPTIONS)
+        .unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()));
+    let (mut positions, mut triangles) = (Vec::new(), Vec::new());
+    for m in models {
+        let base = positions.len() as u32;
+        positions.extend(m.mesh.positions.chunks_exact(3).map(|p| Vec3::new(p[0], p[1], p[2])));
+        triangles.extend(m.mesh.indices.chunks_exact(3).map(|t| [base + t[0], base + t[1], base + t[2]]));
+    }
+    TriangleMesh::new(positions, triangles).expect("a valid mesh")
+}
+
+fn rays_around(bounds: Aabb, count: usize) -> Vec<Ray> {
+    let mut state = 0x2545_f491_4f6c_dd1du64;
+    let mut next = move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 40) as f32 / (1u64 << 24) as f32
+    };
+    let (centre, extent) = (bounds.center(), bounds.extent());
+    let radius = extent.length();
+    (0..count)
+        .map(|_| {
+            let dir = Vec3::new(next() - 0.5, next() - 0.5, next() - 0.5).normalize_or(Vec3::X);
+            let origin = centre + dir * radius;
+            let target = bounds.min + extent * Vec3::new(next(), next(), next());
+            Ray::new(origin, target - origin)
+        })
+        .collect()
+}
+
+fn work(accel: &impl Accel, mesh: &TriangleMesh, rays: &[Ray]) -> (f64, f64) {
+    let mut c = WorkCounts::default();
+    for r in rays {
+        accel.closest_hit(r, &mut c, |i, r| mesh.intersect(i, r));
+    }
+    let n = rays.len() as f64;
+    (c.exact_tests as f64 / n, c.nodes_visited as f64 / n)
+}
+
+#[test]
+#[ignore = "figures for docs/accelerators.md, not a check"]
+fn print_the_figures() {
+    for relative in [
+        "scenes/meshes/bunny/stanford-bunny.obj",
+        "scenes/meshes/sponza-dabrovic/sponza.obj",
+        "scenes/meshes/teapot/teapot.obj",
+    ] {
+        let mesh = load_obj(relative);
+        let boxes: Vec<Aabb> = (0..mesh.len() as u32).map(|t| mesh.triangle_bounds(t)).collect();
+        let rays = rays_around(mesh.bounds(), 20_000);
+        let exact = |i: u32, c: &Aabb| clip_triangle(mesh.triangle(i).vertices, c);
+        let boxed = |i: u32, c: &Aabb| boxes[i as usize].intersection(c);
+        println!("\n{relative}: {} triangles, {} rays", mesh.len(), rays.len());
+        for &kind in AccelKind::ALL.iter().filter(|&&k| k != AccelKind::None && k != AccelKind::BvhSeed) {
+            let (tests, nodes) = work(&AnyAccel::build_with_clipper(kind, &boxes, &exact), &mesh, &rays);
+            println!("  {:<40} tests/ray {tests:7.2}  nodes/ray {nodes:7.2}", kind.name());
+        }
+        let base = KdTreeParams::default();
+        let variants = [
+            ("kdtree (defaults)", base, true),
+            ("kdtree, box clipping", base, false),
+            ("kdtree, no mailbox", KdTreeParams { mailbox: false, ..base }, true),
+            ("kdtree, no empty space bonus", KdTreeParams { empty_bonus: 0.0, ..base }, true),
+            ("kdtree, K_T 1 K_I 1", KdTreeParams { intersection_cost: 1.0, ..base }, true),
+            ("kdtree, K_T 1 K_I 3", KdTreeParams { intersection_cost: 3.0, ..base }, true),
+            ("kdtree, K_T 1 K_I 10", KdTreeParams { intersection_cost: 10.0, ..base }, true),
+            (
+                "kdtree, K_T 15 K_I 20 (Wald-Havran)",
+                KdTreeParams { traversal_cost: 15.0, intersection_cost: 20.0, ..base },
+                true,
+            ),
+            ("kdtree, K_T 1 K_I 80 (pbrt)", KdTreeParams { intersection_cost: 80.0, empty_bonus: 0.5, ..base }, true),
+        ];
+        for (name, params, exact_clip) in variants {
+            let start = std::time::Instant::now();
+            let tree = if exact_clip {
+                KdTree::build_with_clipper(&boxes, &exact, params)
+            } else {
+                KdTree::build_with_clipper(&boxes, &boxed, params)
+            };
+            let seconds = start.elapsed().as_secs_f64();
+            let q = validate_kdtree(&tree, &boxes).unwrap();
+            let (tests, nodes) = work(&tree, &mesh, &rays);
+            println!(
+                "  {name:<40} tests/ray {tests:7.2}  nodes/ray {nodes:7.2}  refs/prim {:.2}  depth {}  nodes {}  SAH {:.1}  build {seconds:.2} s",
+                q.refs_per_prim,
+                q.depth,
+                q.interior + q.leaves,
+                q.sah_cost
+            );
+        }
+        for (lambda, mailbox) in [(1.0, true), (1.5, true), (2.0, true), (2.0, false), (3.0, true), (4.0, true)] {
+            let grid = Grid::build_with(&boxes, GridParams { lambda, mailbox, ..GridParams::default() });
+            let q = validate_grid(&grid, &boxes).unwrap();
+            let (tests, nodes) = work(&grid, &mesh, &rays);
+            println!(
+                "  grid, lambda {lambda}{:<26} tests/ray {tests:7.2}  cells/ray {nodes:7.2}  refs/prim {:.2}  cells {} ({:?})",
+                if mailbox { "" } else { ", no mailbox" },
+                q.refs_per_prim,
+                q.cells,
+                q.resolution
+            );
+        }
+    }
+}
