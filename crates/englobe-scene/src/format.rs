@@ -32,6 +32,8 @@ pub struct SceneFile {
     #[serde(default)]
     pub triangle: Vec<Spanned<TriangleDef>>,
     #[serde(default)]
+    pub random_triangles: Vec<Spanned<RandomTrianglesDef>>,
+    #[serde(default)]
     pub mesh: Vec<Spanned<MeshDef>>,
 }
 
@@ -134,6 +136,19 @@ pub struct BoxDef {
 #[serde(deny_unknown_fields)]
 pub struct TriangleDef {
     pub vertices: [Point; 3],
+    pub material: Option<Spanned<String>>,
+}
+
+/// A box filled with random triangles (see `crate::random_triangles`).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RandomTrianglesDef {
+    pub count: Spanned<u32>,
+    pub min: Point,
+    pub max: Point,
+    pub size: Positive,
+    #[serde(default)]
+    pub seed: u64,
     pub material: Option<Spanned<String>>,
 }
 

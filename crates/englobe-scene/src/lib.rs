@@ -12,6 +12,7 @@ pub mod model;
 pub mod numbers;
 pub mod parse;
 mod parse_mesh;
+pub mod random_triangles;
 pub mod shared_data;
 
 pub use error::{Located, SceneError};
@@ -21,3 +22,4 @@ pub use model::{
 };
 pub use parse::{DEFAULT_MATERIAL, load_scene, parse_scene};
 pub use parse_mesh::MAX_MESH_INSTANCES;
+pub use random_triangles::MAX_RANDOM_TRIANGLES;

@@ -138,6 +138,10 @@ impl Converter<'_> {
             }
             push(tri.into(), lookup(&t.material)?);
         }
+        for r in def.random_triangles {
+            let material = lookup(&r.get_ref().material)?;
+            push(self.random_triangles(r)?, material);
+        }
         let mut scene = Scene { image, camera, lights, materials, material_names, objects, warnings: Vec::new() };
         self.meshes(def.mesh, &mut scene)?;
         Ok(scene)

@@ -175,3 +175,42 @@ fn sphere_grid_expands_in_order() {
     let englobe::Object::Shape(englobe::Shape::Sphere(last)) = &s.objects[6].object else { panic!() };
     assert_eq!(last.center, englobe::Vec3::new(2.0, 2.0, 10.0));
 }
+
+#[test]
+fn random_triangles_are_checked_and_generated() {
+    let entry = |body: &str| format!("[[random_triangles]]\n{body}\n[[sphere]]");
+    check("[[sphere]]", &entry("count = 0\nmin = [0,0,0]\nmax = [1,1,1]\nsize = 0.1"), "0\n", "expected 1 to");
+    check(
+        "[[sphere]]",
+        &entry("count = 20000000\nmin = [0,0,0]\nmax = [1,1,1]\nsize = 0.1"),
+        "20000000",
+        "expected 1 to 16777216",
+    );
+    check(
+        "[[sphere]]",
+        &entry("count = 10\nmin = [0,2,0]\nmax = [1,1,1]\nsize = 0.1"),
+        "[[random_triangles]]",
+        "min <= max",
+    );
+    check("[[sphere]]", &entry("count = 10\nmin = [0,0,0]\nmax = [1,1,1]\nsize = -1"), "-1", "greater than 0");
+    check(
+        "[[sphere]]",
+        &entry("count = 10\nmin = [0,0,0]\nmax = [1,1,1]\nsize = 1\nsides = 3"),
+        "sides",
+        "unknown field",
+    );
+
+    let text = GOOD.replacen(
+        "[[sphere]]",
+        &entry("count = 500\nmin = [-1,-1,-1]\nmax = [1,1,1]\nsize = 0.2\nseed = 9\nmaterial = \"red\""),
+        1,
+    );
+    let s = parse_scene(&text, "soup.toml".as_ref()).unwrap();
+    let again = parse_scene(&text, "soup.toml".as_ref()).unwrap();
+    // After the sphere (spheres come first), one mesh of 500 triangles, the same every time.
+    assert_eq!(s.objects.len(), 2);
+    let englobe::Object::Mesh(mesh) = &s.objects[1].object else { panic!("a mesh") };
+    assert_eq!(mesh.len(), 500);
+    assert_eq!(s.objects[1].material, 1);
+    assert_eq!(s.objects, again.objects);
+}

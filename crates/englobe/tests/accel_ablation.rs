@@ -32,6 +32,26 @@ fn load_obj(relative: &str) -> TriangleMesh {
     TriangleMesh::new(positions, triangles).expect("a valid mesh")
 }
 
+/// `n` random triangles of size `size` with centres in the cube `[-half, half]^3`.
+fn soup(n: usize, half: f32, size: f32) -> TriangleMesh {
+    let mut state = 0x9e37_79b9_7f4a_7c15u64;
+    let mut next = move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 40) as f32 / (1u64 << 24) as f32
+    };
+    let mut positions = Vec::with_capacity(3 * n);
+    for _ in 0..n {
+        let c = Vec3::new(next(), next(), next()) * 2.0 * half - Vec3::splat(half);
+        for _ in 0..3 {
+            positions.push(c + (Vec3::new(next(), next(), next()) - Vec3::splat(0.5)) * size);
+        }
+    }
+    let triangles = (0..n as u32).map(|i| [3 * i, 3 * i + 1, 3 * i + 2]).collect();
+    TriangleMesh::new(positions, triangles).unwrap()
+}
+
 fn rays_around(bounds: Aabb, count: usize) -> Vec<Ray> {
     let mut state = 0x2545_f491_4f6c_dd1du64;
     let mut next = move || {
@@ -65,11 +85,12 @@ fn work(accel: &impl Accel, mesh: &TriangleMesh, rays: &[Ray]) -> (f64, f64) {
 #[ignore = "figures for docs/accelerators.md, not a check"]
 fn print_the_figures() {
     for relative in [
+        "uniform soup",
         "scenes/meshes/bunny/stanford-bunny.obj",
         "scenes/meshes/sponza-dabrovic/sponza.obj",
         "scenes/meshes/teapot/teapot.obj",
     ] {
-        let mesh = load_obj(relative);
+        let mesh = if relative == "uniform soup" { soup(100_000, 10.0, 0.5) } else { load_obj(relative) };
         let boxes: Vec<Aabb> = (0..mesh.len() as u32).map(|t| mesh.triangle_bounds(t)).collect();
         let rays = rays_around(mesh.bounds(), 20_000);
         let exact = |i: u32, c: &Aabb| clip_triangle(mesh.triangle(i).vertices, c);
@@ -81,19 +102,23 @@ fn print_the_figures() {
         }
         let base = KdTreeParams::default();
         let variants = [
-            ("kdtree (defaults)", base, true),
+            ("kdtree (defaults: K_T 1, K_I 20)", base, true),
             ("kdtree, box clipping", base, false),
             ("kdtree, no mailbox", KdTreeParams { mailbox: false, ..base }, true),
             ("kdtree, no empty space bonus", KdTreeParams { empty_bonus: 0.0, ..base }, true),
-            ("kdtree, K_T 1 K_I 1", KdTreeParams { intersection_cost: 1.0, ..base }, true),
-            ("kdtree, K_T 1 K_I 3", KdTreeParams { intersection_cost: 3.0, ..base }, true),
-            ("kdtree, K_T 1 K_I 10", KdTreeParams { intersection_cost: 10.0, ..base }, true),
+            ("kdtree, K_I 1.5", KdTreeParams { intersection_cost: 1.5, ..base }, true),
+            ("kdtree, K_I 5", KdTreeParams { intersection_cost: 5.0, ..base }, true),
             (
-                "kdtree, K_T 15 K_I 20 (Wald-Havran)",
-                KdTreeParams { traversal_cost: 15.0, intersection_cost: 20.0, ..base },
+                "kdtree, K_I 80, bonus 0.5 (pbrt)",
+                KdTreeParams { intersection_cost: 80.0, empty_bonus: 0.5, ..base },
                 true,
             ),
-            ("kdtree, K_T 1 K_I 80 (pbrt)", KdTreeParams { intersection_cost: 80.0, empty_bonus: 0.5, ..base }, true),
+            ("kdtree, K_T 15, K_I 20 (Wald-Havran)", KdTreeParams { traversal_cost: 15.0, ..base }, true),
+            (
+                "kdtree, depth limit + 3",
+                KdTreeParams { max_depth: Some(base.depth_limit(mesh.len()) + 3), ..base },
+                true,
+            ),
         ];
         for (name, params, exact_clip) in variants {
             let start = std::time::Instant::now();

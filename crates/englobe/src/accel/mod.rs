@@ -214,7 +214,7 @@ impl AccelKind {
             AccelKind::KdTree => {
                 "SAH kd-tree built in O(N log N) with split clipping, traversed front to back with mailboxing"
             }
-            AccelKind::Grid => "uniform grid of about 8 cells per primitive, traversed with the 3D-DDA and mailboxing",
+            AccelKind::Grid => "uniform grid of about 27 cells per primitive, traversed with the 3D-DDA and mailboxing",
         }
     }
 }

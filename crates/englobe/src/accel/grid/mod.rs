@@ -28,7 +28,9 @@ use crate::{Aabb, Ray};
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct GridParams {
     /// Cells per axis of a cubic box, per cube root of the number of primitives: a grid has about
-    /// `lambda^3` cells per primitive.
+    /// `lambda^3` cells per primitive. The default, 3, is pbrt's first edition's (Pharr and
+    /// Humphreys 2004, "Physically Based Rendering", section 4.3); `docs/accelerators.md` measures
+    /// others.
     pub lambda: f32,
     /// Most cells (the resolution is lowered until it fits). At most `2^30`.
     pub max_cells: u64,
@@ -42,7 +44,7 @@ pub struct GridParams {
 
 impl Default for GridParams {
     fn default() -> Self {
-        GridParams { lambda: 2.0, max_cells: 1 << 24, max_refs: 1 << 26, mailbox: true }
+        GridParams { lambda: 3.0, max_cells: 1 << 24, max_refs: 1 << 26, mailbox: true }
     }
 }
 
