@@ -1,8 +1,10 @@
 //! `englobe compare SCENE`: every structure of `AccelKind::ALL` built for one scene and used to
 //! render it: build time, memory, rays per second (and how many times brute force's), and the
 //! work per ray (exact tests, nodes visited, box tests); then whether its image is brute force's,
-//! bit for bit. A second table gives the quality of every tree: SAH cost (and its ratio to the
-//! full-sweep builder's), interior nodes, leaves, depth and the leaves' sizes.
+//! bit for bit. A second table gives the quality of every structure: SAH cost (and its ratio to
+//! the full-sweep builder's) where it applies, interior nodes, leaves (a grid's cells), depth,
+//! references per primitive (more than one where a structure lists a primitive in every cell it
+//! overlaps) and the leaves' sizes. `--plot` draws rays per second and exact tests per ray.
 //!
 //! A structure whose full render would take longer than the time budget (brute force on a large
 //! mesh) is measured on a regular sample of the pixels instead: every `n`-th pixel of every
@@ -21,6 +23,7 @@ use englobe_scene::Scene;
 use serde::Serialize;
 
 use crate::measure::{MAX_TIMED_RUNS, MIN_TIMED_SECONDS, RenderSettings, build, compare_films, render, thread_pool};
+use crate::plot::{PlotRow, write_svg};
 use crate::render_cmd::{parse_accel, read_scene};
 use crate::report::{bytes, write_json};
 
@@ -53,6 +56,9 @@ pub struct CompareArgs {
     /// Also write the table as JSON to this file.
     #[arg(long, value_name = "FILE")]
     json: Option<PathBuf>,
+    /// Also draw rays per second and exact tests per ray of every structure into this SVG file.
+    #[arg(long, value_name = "FILE.svg")]
+    plot: Option<PathBuf>,
     /// No progress lines on standard error.
     #[arg(short, long)]
     quiet: bool,
@@ -69,8 +75,10 @@ struct Row {
     interior_nodes: usize,
     leaves: usize,
     depth: usize,
-    /// Primitive references held by the leaves.
+    /// Primitive references held by the leaves (cells).
     prim_refs: usize,
+    /// References per primitive of the structure.
+    refs_per_prim: f64,
     /// SAH cost, with the constants of the report's `sah_constants`.
     sah_cost: Option<f32>,
     /// SAH cost over bvh-sweep's, when both were built.
@@ -164,7 +172,10 @@ pub fn run(args: CompareArgs) -> anyhow::Result<ExitCode> {
         let (film_ref, stride_ref) = reference.get_or_insert_with(|| (timed.film.clone(), stride));
         let (compared, differing) = compare_films(film_ref, *stride_ref, &timed.film, stride);
         let timing = Timing { seconds, runs: timed_runs, rays: timed.stats.total().rays };
-        rows.push(row(kind, build_seconds, &world.stats(), timing, &counted, stride, compared, differing));
+        let stats = world.stats();
+        let mut r = row(kind, build_seconds, &stats, timing, &counted, stride, compared, differing);
+        r.refs_per_prim = if primitives == 0 { 0.0 } else { stats.prim_refs as f64 / primitives as f64 };
+        rows.push(r);
     }
     relate_rows(&mut rows);
     let threads = pool.current_num_threads();
@@ -183,6 +194,19 @@ pub fn run(args: CompareArgs) -> anyhow::Result<ExitCode> {
             rows: rows.clone(),
         };
         write_json(path, &report)?;
+    }
+    if let Some(path) = &args.plot {
+        let plotted: Vec<PlotRow> = rows
+            .iter()
+            .map(|r| PlotRow {
+                name: r.accel.to_owned(),
+                rays_per_second: r.rays_per_second,
+                exact_tests_per_ray: r.exact_tests_per_ray,
+            })
+            .collect();
+        let subtitle =
+            format!("{primitives} primitives, {width}x{height}, {samples} sample(s) per pixel, {threads} threads");
+        write_svg(path, &scene_name, &subtitle, &plotted)?;
     }
     if rows.iter().any(|r| !r.image_equal) {
         eprintln!("error: some structures drew a different image than brute force");
@@ -239,6 +263,7 @@ fn row(
         leaves: s.leaves,
         depth: s.depth,
         prim_refs: s.prim_refs,
+        refs_per_prim: 0.0,
         sah_cost: s.sah_cost,
         sah_vs_sweep: None,
         leaf_sizes: s.leaf_sizes,
@@ -326,42 +351,40 @@ fn table(scene: &str, primitives: usize, w: u32, h: u32, spp: u32, threads: usiz
     out
 }
 
-/// The shape and SAH cost of every structure that has them.
+/// The shape of every structure but brute force, and its SAH cost where it has one.
 fn quality_table(rows: &[Row]) -> String {
-    let trees: Vec<&Row> = rows.iter().filter(|r| r.sah_cost.is_some()).collect();
-    if trees.is_empty() {
+    let shaped: Vec<&Row> = rows.iter().filter(|r| r.accel != AccelKind::None.name()).collect();
+    if shaped.is_empty() {
         return String::new();
     }
     let mut out = format!(
         "\nQuality: SAH cost = expected cost of a ray that hits the root box, {SAH_TRAVERSAL_COST} per interior node \
-         and {SAH_INTERSECTION_COST} per primitive of a leaf, each node weighted by its area over the root's.\n\n"
+         and {SAH_INTERSECTION_COST} per primitive of a leaf, each node weighted by its area over the root's (a \
+         kd-tree's nodes are cells; a grid has none). A grid's leaves are its cells; refs/prim: references per \
+         primitive; leaf sizes count non-empty leaves.\n\n"
     );
     out += &format!(
-        "{:<18} {:>10} {:>9} {:>9} {:>9} {:>6}  {:<44} {:>6}\n",
+        "{:<18} {:>10} {:>9} {:>9} {:>9} {:>6} {:>9}  {:<44} {:>6}\n",
         "accelerator",
         "SAH cost",
         "vs sweep",
         "interior",
         "leaves",
         "depth",
+        "refs/prim",
         "leaves of 1 2 3 4 5 6 7 8 9+ primitives",
         "mean"
     );
-    out += &format!("{}\n", "-".repeat(122));
-    for r in trees {
+    out += &format!("{}\n", "-".repeat(132));
+    for r in shaped {
+        let sah = r.sah_cost.map_or("-".to_owned(), |c| format!("{c:.3}"));
         let vs_sweep = r.sah_vs_sweep.map_or("-".to_owned(), |v| format!("{v:.3}"));
         let sizes = r.leaf_sizes.iter().map(|n| n.to_string()).collect::<Vec<_>>().join(" ");
-        let mean = if r.leaves == 0 { 0.0 } else { r.prim_refs as f64 / r.leaves as f64 };
+        let filled: usize = r.leaf_sizes.iter().sum();
+        let mean = if filled == 0 { 0.0 } else { r.prim_refs as f64 / filled as f64 };
         out += &format!(
-            "{:<18} {:>10.3} {:>9} {:>9} {:>9} {:>6}  {:<44} {:>6.2}\n",
-            r.accel,
-            r.sah_cost.unwrap_or(0.0),
-            vs_sweep,
-            r.interior_nodes,
-            r.leaves,
-            r.depth,
-            sizes,
-            mean
+            "{:<18} {:>10} {:>9} {:>9} {:>9} {:>6} {:>9.2}  {:<44} {:>6.2}\n",
+            r.accel, sah, vs_sweep, r.interior_nodes, r.leaves, r.depth, r.refs_per_prim, sizes, mean
         );
     }
     out

@@ -7,6 +7,7 @@ mod info_cmd;
 mod interrupt;
 mod measure;
 mod memory;
+mod plot;
 mod progress;
 mod render_cmd;
 mod report;
