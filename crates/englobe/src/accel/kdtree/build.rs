@@ -52,6 +52,7 @@ pub struct SplitPlane {
 
 /// The SAH cost of splitting `cell` at `pos` along `axis` with `below` and `above` primitives on
 /// each side (`inv_area` is one over the cell's surface area).
+#[inline]
 pub fn split_cost(
     cell: &Aabb,
     axis: usize,
@@ -229,7 +230,17 @@ impl Builder<'_> {
                 _ => {}
             }
         }
-        let (mut below, mut above) = (Vec::with_capacity(events.len()), Vec::with_capacity(events.len()));
+        // Exact sizes first: the lists of a deep tree's pending siblings are what the build's
+        // memory is made of.
+        let (mut size_below, mut size_above) = (0, 0);
+        for e in &events {
+            match self.side[e.prim as usize] {
+                Side::Below => size_below += 1,
+                Side::Above => size_above += 1,
+                Side::Both => {}
+            }
+        }
+        let (mut below, mut above) = (Vec::with_capacity(size_below), Vec::with_capacity(size_above));
         let (mut n_below, mut n_above) = (0, 0);
         let mut straddling = Vec::new();
         for e in &events {
@@ -263,8 +274,6 @@ impl Builder<'_> {
         }
         sort_events(&mut new_below);
         sort_events(&mut new_above);
-        below.shrink_to_fit();
-        above.shrink_to_fit();
         ((merge_events(below, new_below), n_below), (merge_events(above, new_above), n_above))
     }
 }
