@@ -46,7 +46,9 @@ pub struct KdTreeParams {
     pub empty_bonus: f32,
     /// Deepest leaf; `None` for `8 + 1.3 log2(N)` (pbrt's rule). At most [`MAX_DEPTH`].
     pub max_depth: Option<u32>,
-    /// Nodes with this many primitives or fewer become leaves without looking for a split.
+    /// Nodes with this many primitives or fewer become leaves without looking for a split. The
+    /// default, 0, leaves it to the SAH, which goes on cutting empty space off a single primitive's
+    /// cell while that pays (pbrt's 1 stops at one primitive in whatever cell it has).
     pub leaf_size: u32,
     /// Skip primitives a query has already tested in an earlier leaf (see
     /// [`crate::accel::mailbox`]); off only to measure what it saves.
@@ -60,7 +62,7 @@ impl Default for KdTreeParams {
             intersection_cost: 20.0,
             empty_bonus: 0.2,
             max_depth: None,
-            leaf_size: 1,
+            leaf_size: 0,
             mailbox: true,
         }
     }
