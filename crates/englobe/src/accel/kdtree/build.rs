@@ -102,7 +102,8 @@ pub fn find_plane(events: &[Event], n: usize, cell: &Aabb, params: &KdTreeParams
         if pos > cell.min[axis] && pos < cell.max[axis] {
             let (b, p, a) = (below[axis], planar[axis], above[axis]);
             let with_below = split_cost(cell, axis, pos, b + p, a, params, inv_area);
-            let with_above = split_cost(cell, axis, pos, b, a + p, params, inv_area);
+            // With nothing in the plane, both sides cost the same.
+            let with_above = if p == 0 { with_below } else { split_cost(cell, axis, pos, b, a + p, params, inv_area) };
             let (cost, planar_below) = if with_below <= with_above { (with_below, true) } else { (with_above, false) };
             if best.is_none_or(|s| cost < s.cost) {
                 best = Some(SplitPlane { axis, pos, planar_below, cost });
