@@ -11,7 +11,7 @@ use englobe_render::{Renderer, build_world};
 use englobe_scene::load_scene;
 
 /// The BVH the kd-tree and the grid are measured against.
-const BVH: AccelKind = AccelKind::BvhSeedOrdered;
+const BVH: AccelKind = AccelKind::BvhSah;
 
 /// Exact tests per ray of every structure of `kinds`, rendering `name` (under `scenes/`) at
 /// `width` x `height`.

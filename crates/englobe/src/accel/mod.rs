@@ -75,9 +75,9 @@ pub trait Accel: Send + Sync {
 /// Size and shape of a built structure, for comparisons.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct StructureStats {
-    /// Interior nodes (or cells for a grid).
+    /// Interior nodes (none for a grid).
     pub nodes: usize,
-    /// Leaves (or non-empty cells).
+    /// Leaves, empty ones included (a grid's cells).
     pub leaves: usize,
     /// Longest path from the root to a leaf (0 when there is no tree).
     pub depth: usize,
