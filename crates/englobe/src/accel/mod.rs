@@ -277,11 +277,12 @@ impl AnyAccel {
 
     /// Builds the structure `kind`; structures that split primitives across cells (the kd-tree)
     /// ask `clip(prim, cell)` for the box of the part of primitive `prim` inside `cell`, which can
-    /// be much tighter than the box's part (see [`crate::shapes::clip_triangle`]).
+    /// be much tighter than the box's part (see [`crate::shapes::clip_triangle`]); the grid lists
+    /// a primitive only in the cells where that part is not empty.
     pub fn build_with_clipper(kind: AccelKind, boxes: &[Aabb], clip: ClipFn<'_>) -> Self {
         match kind {
             AccelKind::KdTree => AnyAccel::KdTree(KdTree::build_with_clipper(boxes, clip, KdTreeParams::default())),
-            AccelKind::Grid => AnyAccel::Grid(Grid::build(boxes)),
+            AccelKind::Grid => AnyAccel::Grid(Grid::build_with_clipper(boxes, clip, GridParams::default())),
             AccelKind::None => AnyAccel::BruteForce(BruteForce::build(boxes)),
             AccelKind::BvhSeed => AnyAccel::BvhSeed(CandidateListBvh::build(boxes)),
             AccelKind::BvhSeedOrdered => AnyAccel::BvhSeedOrdered(SeedPairing::build(boxes)),

@@ -7,7 +7,7 @@
 use std::path::PathBuf;
 
 use englobe::accel::ClipFn;
-use englobe::accel::grid::stats::validate_grid;
+use englobe::accel::grid::stats::validate_grid_clipped;
 use englobe::accel::kdtree::stats::validate_kdtree;
 use englobe::accel::validate::validate_bvh;
 use englobe::{Aabb, Accel, AccelKind, AnyAccel, Hit, NoCount, PrimHit, Ray, WorkCounts};
@@ -48,6 +48,7 @@ pub fn check_all_structures_clipped(
     let mut builds: Vec<(String, AnyAccel)> =
         AccelKind::ALL.iter().map(|&k| (k.to_string(), AnyAccel::build_with_clipper(k, boxes, clip))).collect();
     builds.push(("kdtree with box clipping".to_owned(), AnyAccel::build(AccelKind::KdTree, boxes)));
+    builds.push(("grid with box clipping".to_owned(), AnyAccel::build(AccelKind::Grid, boxes)));
     for (kind, accel) in &builds {
         if let Some(bvh) = accel.bvh() {
             validate_bvh(bvh, boxes).map_err(|e| format!("{kind}: invalid tree: {e}"))?;
@@ -56,7 +57,7 @@ pub fn check_all_structures_clipped(
             validate_kdtree(tree, boxes).map_err(|e| format!("{kind}: invalid tree: {e}"))?;
         }
         if let Some(grid) = accel.grid() {
-            validate_grid(grid, boxes).map_err(|e| format!("{kind}: invalid grid: {e}"))?;
+            validate_grid_clipped(grid, boxes, Some(clip)).map_err(|e| format!("{kind}: invalid grid: {e}"))?;
         }
         for (ray, &(closest, any)) in rays.iter().zip(&expected) {
             let got = accel.closest_hit(ray, &mut NoCount, intersect);

@@ -19,11 +19,17 @@
 //! ray crosses near an edge or a corner of cells, rounding may order its crossings wrongly by that
 //! much, and a primitive touching that corner is then in whichever cell the traversal visits.
 //! Lists are filled in primitive order (so each is sorted) in two passes: count, then place.
+//! Given a clipper (as the kd-tree is, see [`crate::shapes::clip_triangle`]), a primitive is left
+//! out of the cells its box overlaps but its shape does not: a long thin triangle lying across the
+//! diagonal of its box touches a few of the cells the box covers, and every cell it is wrongly
+//! listed in costs the rays crossing that cell an exact test. The cell is grown by the same margin
+//! before clipping.
 
 use glam::DVec3;
 
 use super::{Grid, GridParams};
 use crate::Aabb;
+use crate::accel::ClipFn;
 
 /// Most cells along one axis.
 pub const MAX_AXIS_CELLS: u32 = 1 << 12;
@@ -94,6 +100,24 @@ impl Frame {
         std::array::from_fn(|a| (cell(b.min[a] - self.margin, a), cell(b.max[a] + self.margin, a)))
     }
 
+    /// Cell `(x, y, z)` as a box, grown by the margin.
+    fn cell_box(&self, x: u32, y: u32, z: u32) -> Aabb {
+        let (min, max) = (self.bounds.min, self.bounds.max);
+        let at = [x, y, z];
+        let bound = |a: usize, i: u32| {
+            if self.inv_cell_size[a] == 0.0 || i >= self.res[a] {
+                max[a]
+            } else if i == 0 {
+                min[a]
+            } else {
+                min[a] + i as f32 / self.inv_cell_size[a]
+            }
+        };
+        let lo = glam::Vec3::from_array(std::array::from_fn(|a| if at[a] == 0 { min[a] } else { bound(a, at[a]) }));
+        let hi = glam::Vec3::from_array(std::array::from_fn(|a| bound(a, at[a] + 1)));
+        Aabb::new(lo - self.margin, hi + self.margin)
+    }
+
     fn cells(&self) -> u64 {
         self.res.iter().map(|&r| r as u64).product()
     }
@@ -112,7 +136,7 @@ fn has_box(b: &Aabb) -> bool {
     !b.is_empty() && b.is_finite()
 }
 
-pub(super) fn build(boxes: &[Aabb], params: GridParams) -> Grid {
+pub(super) fn build(boxes: &[Aabb], clip: Option<ClipFn<'_>>, params: GridParams) -> Grid {
     let max_cells = params.max_cells.clamp(1, 1 << 30);
     let max_refs = params.max_refs.clamp(1, u32::MAX as u64 - 1);
     let (bounds, n) = boxes.iter().filter(|b| has_box(b)).fold((Aabb::EMPTY, 0usize), |(u, n), b| (u.union(b), n + 1));
@@ -148,26 +172,35 @@ pub(super) fn build(boxes: &[Aabb], params: GridParams) -> Grid {
             break frame;
         }
     };
-    fill(boxes, frame, params.mailbox)
+    fill(boxes, clip, frame, params.mailbox)
 }
 
 /// Counts, then places, every primitive in its cells.
-fn fill(boxes: &[Aabb], frame: Frame, mailbox: bool) -> Grid {
+fn fill(boxes: &[Aabb], clip: Option<ClipFn<'_>>, frame: Frame, mailbox: bool) -> Grid {
     let [nx, ny, _] = frame.res.map(|r| r as usize);
     let cells = frame.cells() as usize;
     let index = |x: u32, y: u32, z: u32| (z as usize * ny + y as usize) * nx + x as usize;
-    let for_cells = |r: &[(u32, u32); 3], f: &mut dyn FnMut(usize)| {
+    // Calls `f` with every cell primitive `prim` is listed in.
+    let for_cells = |prim: usize, b: &Aabb, f: &mut dyn FnMut(usize)| {
+        let r = frame.range(b);
+        let whole_box = r.iter().all(|&(lo, hi)| lo == hi);
         for z in r[2].0..=r[2].1 {
             for y in r[1].0..=r[1].1 {
                 for x in r[0].0..=r[0].1 {
-                    f(index(x, y, z));
+                    let touches = match clip {
+                        Some(clip) if !whole_box => !clip(prim as u32, &frame.cell_box(x, y, z)).is_empty(),
+                        _ => true,
+                    };
+                    if touches {
+                        f(index(x, y, z));
+                    }
                 }
             }
         }
     };
     let mut cell_start = vec![0u32; cells + 1];
-    for b in boxes.iter().filter(|b| has_box(b)) {
-        for_cells(&frame.range(b), &mut |c| cell_start[c + 1] += 1);
+    for (prim, b) in boxes.iter().enumerate().filter(|(_, b)| has_box(b)) {
+        for_cells(prim, b, &mut |c| cell_start[c + 1] += 1);
     }
     for c in 0..cells {
         cell_start[c + 1] += cell_start[c];
@@ -175,7 +208,7 @@ fn fill(boxes: &[Aabb], frame: Frame, mailbox: bool) -> Grid {
     let mut refs = vec![0u32; cell_start[cells] as usize];
     let mut cursor = cell_start.clone();
     for (prim, b) in boxes.iter().enumerate().filter(|(_, b)| has_box(b)) {
-        for_cells(&frame.range(b), &mut |c| {
+        for_cells(prim, b, &mut |c| {
             refs[cursor[c] as usize] = prim as u32;
             cursor[c] += 1;
         });
@@ -277,5 +310,30 @@ mod tests {
         let g = Grid::build(&[Aabb::EMPTY, Aabb::new(Vec3::splat(f32::NAN), Vec3::ONE)]);
         assert_eq!(g.cell_count(), 0);
         assert!(g.bounds.is_empty());
+    }
+
+    #[test]
+    fn a_clipper_keeps_a_diagonal_triangle_out_of_the_cells_it_misses() {
+        // A thin triangle along the diagonal of the box, and small boxes filling the rest so that
+        // the grid is fine: its box overlaps every cell, its shape only those near the diagonal.
+        let tri = [Vec3::ZERO, Vec3::splat(8.0), Vec3::new(8.0, 8.0, 7.9)];
+        let mut boxes = vec![Aabb::from_points(tri)];
+        boxes.extend((0..511).map(|i| cube(Vec3::new((i % 8) as f32, (i / 8 % 8) as f32, (i / 64) as f32), 0.1)));
+        let clip = |prim: u32, cell: &Aabb| {
+            if prim == 0 { crate::shapes::clip_triangle(tri, cell) } else { boxes[prim as usize].intersection(cell) }
+        };
+        let params = GridParams { lambda: 1.0, ..GridParams::default() };
+        let plain = Grid::build_with(&boxes, params);
+        let clipped = Grid::build_with_clipper(&boxes, &clip, params);
+        let listed = |g: &Grid| g.refs.iter().filter(|&&p| p == 0).count();
+        let cells = plain.cell_count();
+        assert_eq!(listed(&plain), cells);
+        assert!(listed(&clipped) * 4 < cells, "{} of {cells} cells", listed(&clipped));
+        // Every cell the triangle's diagonal crosses still lists it.
+        let [nx, ny, nz] = clipped.resolution();
+        for i in 0..nx.min(ny).min(nz) {
+            assert!(clipped.cell(i, i, i).contains(&0), "cell {i}");
+        }
+        crate::accel::grid::stats::validate_grid_clipped(&clipped, &boxes, Some(&clip)).unwrap();
     }
 }

@@ -20,7 +20,7 @@ pub mod traverse;
 
 use glam::Vec3;
 
-use super::{Accel, Counters, Hit, StructureStats};
+use super::{Accel, ClipFn, Counters, Hit, StructureStats};
 use crate::shapes::PrimHit;
 use crate::{Aabb, Ray};
 
@@ -71,12 +71,19 @@ impl Grid {
     /// Builds the grid over the primitives' boxes with the default parameters. Primitives with an
     /// empty or non-finite box are left out: no ray can be said to hit them.
     pub fn build(boxes: &[Aabb]) -> Self {
-        build::build(boxes, GridParams::default())
+        build::build(boxes, None, GridParams::default())
     }
 
     /// Builds the grid with `params`.
     pub fn build_with(boxes: &[Aabb], params: GridParams) -> Self {
-        build::build(boxes, params)
+        build::build(boxes, None, params)
+    }
+
+    /// Builds the grid with `params`, listing a primitive only in the cells where
+    /// `clip(prim, cell)` is not empty: the part of primitive `prim` inside `cell`, as for
+    /// [`crate::accel::KdTree::build_with_clipper`].
+    pub fn build_with_clipper(boxes: &[Aabb], clip: ClipFn<'_>, params: GridParams) -> Self {
+        build::build(boxes, Some(clip), params)
     }
 
     /// Cells along each axis.

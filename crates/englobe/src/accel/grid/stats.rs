@@ -5,12 +5,13 @@
 //!
 //! [`validate_grid`] checks that the offsets are sorted and end at the number of references, that
 //! every list is sorted and names existing primitives, that every primitive is listed in every
-//! cell its box overlaps (completeness: the traversal relies on it) and only in cells its box,
-//! grown by the margin of assignment, overlaps (no stray references).
+//! cell its box overlaps (completeness: the traversal relies on it; for a grid built with a
+//! clipper, every such cell the clipper finds part of it in) and only in cells its box, grown by
+//! the margin of assignment, overlaps (no stray references).
 
 use super::Grid;
 use crate::Aabb;
-use crate::accel::{LEAF_SIZE_BUCKETS, StructureStats};
+use crate::accel::{ClipFn, LEAF_SIZE_BUCKETS, StructureStats};
 
 /// A broken invariant of a grid.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -108,6 +109,16 @@ impl Grid {
 
 /// Checks every invariant of `grid` built over `prim_boxes`, and measures it.
 pub fn validate_grid(grid: &Grid, prim_boxes: &[Aabb]) -> Result<GridQuality, GridError> {
+    validate_grid_clipped(grid, prim_boxes, None)
+}
+
+/// [`validate_grid`] for a grid built with a clipper ([`Grid::build_with_clipper`]): a primitive
+/// need only be listed in the cells its box overlaps where `clip` finds part of it.
+pub fn validate_grid_clipped(
+    grid: &Grid,
+    prim_boxes: &[Aabb],
+    clip: Option<ClipFn<'_>>,
+) -> Result<GridQuality, GridError> {
     let has_box = |b: &Aabb| !b.is_empty() && b.is_finite();
     let with_box = prim_boxes.iter().filter(|b| has_box(b)).count();
     let cells = grid.cell_count();
@@ -158,8 +169,10 @@ pub fn validate_grid(grid: &Grid, prim_boxes: &[Aabb]) -> Result<GridQuality, Gr
         for z in lo[2]..=hi[2] {
             for y in lo[1]..=hi[1] {
                 for x in lo[0]..=hi[0] {
-                    let cell = grid.linear(x as u32, y as u32, z as u32);
-                    if grid.cell_by_index(cell).binary_search(&(prim as u32)).is_err() {
+                    let (x, y, z) = (x as u32, y as u32, z as u32);
+                    let cell = grid.linear(x, y, z);
+                    let touches = clip.is_none_or(|clip| !clip(prim as u32, &grid.cell_bounds(x, y, z)).is_empty());
+                    if touches && grid.cell_by_index(cell).binary_search(&(prim as u32)).is_err() {
                         return Err(GridError::Missing { cell, prim });
                     }
                 }
