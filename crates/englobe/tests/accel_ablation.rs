@@ -13,7 +13,7 @@
 mod common;
 
 use common::shared_dir;
-use englobe::accel::grid::stats::validate_grid;
+use englobe::accel::grid::stats::validate_grid_clipped;
 use englobe::accel::kdtree::stats::validate_kdtree;
 use englobe::accel::{Grid, GridParams, KdTree, KdTreeParams};
 use englobe::shapes::clip_triangle;
@@ -138,16 +138,30 @@ fn print_the_figures() {
                 q.sah_cost
             );
         }
-        for (lambda, mailbox) in [(1.0, true), (1.5, true), (2.0, true), (2.0, false), (3.0, true), (4.0, true)] {
-            let grid = Grid::build_with(&boxes, GridParams { lambda, mailbox, ..GridParams::default() });
-            let q = validate_grid(&grid, &boxes).unwrap();
+        for (lambda, mailbox, exact_clip) in [
+            (1.0, true, true),
+            (2.0, true, true),
+            (3.0, true, true),
+            (3.0, false, true),
+            (3.0, true, false),
+            (4.0, true, true),
+        ] {
+            let params = GridParams { lambda, mailbox, ..GridParams::default() };
+            let grid = if exact_clip {
+                Grid::build_with_clipper(&boxes, &exact, params)
+            } else {
+                Grid::build_with(&boxes, params)
+            };
+            let q = validate_grid_clipped(&grid, &boxes, Some(&exact)).unwrap();
             let (tests, nodes) = work(&grid, &mesh, &rays);
+            let variant = match (mailbox, exact_clip) {
+                (false, _) => ", no mailbox",
+                (_, false) => ", box clipping",
+                _ => "",
+            };
             println!(
-                "  grid, lambda {lambda}{:<26} tests/ray {tests:7.2}  cells/ray {nodes:7.2}  refs/prim {:.2}  cells {} ({:?})",
-                if mailbox { "" } else { ", no mailbox" },
-                q.refs_per_prim,
-                q.cells,
-                q.resolution
+                "  grid, lambda {lambda}{variant:<26} tests/ray {tests:7.2}  cells/ray {nodes:7.2}  refs/prim {:.2}  cells {} ({:?})",
+                q.refs_per_prim, q.cells, q.resolution
             );
         }
     }

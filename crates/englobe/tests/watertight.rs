@@ -11,8 +11,9 @@
 
 use std::sync::Arc;
 
-use englobe::{AccelKind, Affine3A, Instance, NoCount, Ray, TriangleMesh, Vec3, World};
+use englobe::{AccelKind, Affine3A, Instance, NoCount, Object, Ray, TriangleMesh, Vec3, World};
 use glam::DVec3;
+use rayon::prelude::*;
 
 /// A latitude/longitude sphere with its triangles grouped by cell (band, sector).
 struct UvSphere {
@@ -26,12 +27,15 @@ struct UvSphere {
 }
 
 impl UvSphere {
-    fn new(center: Vec3, radius: f32, bands: usize, sectors: usize) -> Self {
+    /// A sphere whose every vertex lies at `radius * (1 + jitter * u)`, `u` uniform in -1..1
+    /// (the two poles are single vertices shared by a whole band).
+    fn new(center: Vec3, radius: f32, bands: usize, sectors: usize, jitter: f64) -> Self {
         let c = center.as_dvec3();
-        let r = radius as f64;
-        let point = |band: usize, sector: usize| -> Vec3 {
+        let mut rng = Rng(0x5EED ^ (bands * sectors) as u64);
+        let mut point = |band: usize, sector: usize| -> Vec3 {
             let theta = std::f64::consts::PI * band as f64 / bands as f64;
             let phi = -std::f64::consts::PI + std::f64::consts::TAU * sector as f64 / sectors as f64;
+            let r = radius as f64 * (1.0 + jitter * (2.0 * rng.next_f64() - 1.0));
             (c + DVec3::new(theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos()) * r).as_vec3()
         };
         let mut positions = vec![point(0, 0)];
@@ -79,14 +83,15 @@ impl UvSphere {
         let band = ((theta / std::f64::consts::PI * self.bands as f64) as usize).min(self.bands - 1);
         let sector = (((phi + std::f64::consts::PI) / std::f64::consts::TAU * self.sectors as f64) as usize)
             .min(self.sectors - 1);
-        for bd in band.saturating_sub(1)..=(band + 1).min(self.bands - 1) {
-            if bd <= 2 || bd + 3 >= self.bands {
+        // Two cells either way: the jittered vertices move the surface off the ideal sphere.
+        for bd in band.saturating_sub(2)..=(band + 2).min(self.bands - 1) {
+            if bd <= 3 || bd + 4 >= self.bands {
                 // Near a pole every sector is close: take the whole band.
                 for s in 0..self.sectors {
                     out.extend(&self.cells[bd * self.sectors + s]);
                 }
             } else {
-                for ds in [self.sectors - 1, 0, 1] {
+                for ds in [self.sectors - 2, self.sectors - 1, 0, 1, 2] {
                     out.extend(&self.cells[bd * self.sectors + (sector + ds) % self.sectors]);
                 }
             }
@@ -121,22 +126,22 @@ impl Rng {
 }
 
 fn random_rays_from_inside(sphere: &UvSphere, count: usize, seed: u64) -> usize {
-    let mut rng = Rng(seed);
     let mut scratch = Vec::new();
-    let mut misses = 0;
-    for _ in 0..count {
+    random_rays(sphere, count, seed).filter(|ray| !sphere.hits(ray, &mut scratch)).count()
+}
+
+/// `count` rays from uniform points in the inner 90 % of the ball in uniform directions.
+fn random_rays(sphere: &UvSphere, count: usize, seed: u64) -> impl Iterator<Item = Ray> + '_ {
+    let mut rng = Rng(seed);
+    (0..count).map(move |_| {
         let origin = (sphere.center.as_dvec3() + rng.in_ball() * (0.9 * sphere.radius as f64)).as_vec3();
-        let dir = rng.in_ball().normalize().as_vec3();
-        if !sphere.hits(&Ray::new(origin, dir), &mut scratch) {
-            misses += 1;
-        }
-    }
-    misses
+        Ray::new(origin, rng.in_ball().normalize().as_vec3())
+    })
 }
 
 /// Rays aimed exactly at every vertex and every edge midpoint, from the centre and from an
 /// off-centre point inside.
-fn rays_at_vertices_and_edges(sphere: &UvSphere) -> (usize, usize) {
+fn rays_at_vertices_and_edges(sphere: &UvSphere) -> Vec<Ray> {
     let m = &sphere.mesh;
     let mut targets: Vec<Vec3> = m.positions().to_vec();
     for t in m.triangles() {
@@ -146,35 +151,38 @@ fn rays_at_vertices_and_edges(sphere: &UvSphere) -> (usize, usize) {
         }
     }
     let origins = [sphere.center, sphere.center + Vec3::new(0.31, -0.22, 0.47) * sphere.radius];
+    origins.iter().flat_map(|&o| targets.iter().map(move |&target| Ray::new(o, target - o))).collect()
+}
+
+/// How many of the rays aimed at vertices and edge midpoints miss, and how many there are.
+fn misses_at_vertices_and_edges(sphere: &UvSphere) -> (usize, usize) {
+    let rays = rays_at_vertices_and_edges(sphere);
     let mut scratch = Vec::new();
-    let mut misses = 0;
-    for &o in &origins {
-        for &target in &targets {
-            if !sphere.hits(&Ray::new(o, target - o), &mut scratch) {
-                misses += 1;
-            }
-        }
-    }
-    (misses, targets.len() * origins.len())
+    (rays.iter().filter(|ray| !sphere.hits(ray, &mut scratch)).count(), rays.len())
 }
 
 const FAR: Vec3 = Vec3::new(148376.0, 1234.0, -223423.0);
 
+/// Relative jitter of the vertices' radii: a fifth of a band's width on the finest sphere, so the
+/// ideal sphere still tells which cells a ray leaves through, while no two neighbouring triangles
+/// are symmetric.
+const JITTER: f64 = 0.005;
+
 #[test]
 fn a_million_rays_from_inside_a_sphere_at_the_origin_never_miss() {
-    let sphere = UvSphere::new(Vec3::ZERO, 1.0, 128, 256);
+    let sphere = UvSphere::new(Vec3::ZERO, 1.0, 128, 256, JITTER);
     assert_eq!(sphere.mesh.len(), 2 * 128 * 256 - 2 * 256);
     assert_eq!(random_rays_from_inside(&sphere, 1_000_000, 0x9E37_79B9_7F4A_7C15), 0);
-    let (misses, rays) = rays_at_vertices_and_edges(&sphere);
+    let (misses, rays) = misses_at_vertices_and_edges(&sphere);
     assert!(rays > 2 * 190_000, "{rays}");
     assert_eq!(misses, 0, "{misses} of {rays} rays aimed at vertices and edge midpoints missed");
 }
 
 #[test]
 fn a_million_rays_from_inside_a_sphere_far_from_the_origin_never_miss() {
-    let sphere = UvSphere::new(FAR, 100.0, 128, 256);
+    let sphere = UvSphere::new(FAR, 100.0, 128, 256, JITTER);
     assert_eq!(random_rays_from_inside(&sphere, 1_000_000, 0xD1B5_4A32_D192_ED03), 0);
-    let (misses, rays) = rays_at_vertices_and_edges(&sphere);
+    let (misses, rays) = misses_at_vertices_and_edges(&sphere);
     assert_eq!(misses, 0, "{misses} of {rays} rays aimed at vertices and edge midpoints missed");
 }
 
@@ -182,7 +190,7 @@ fn a_million_rays_from_inside_a_sphere_far_from_the_origin_never_miss() {
 fn the_candidate_cells_do_hold_the_hit() {
     // Guard the test's own shortcut: on a coarser sphere, every triangle a ray hits is among its
     // candidates (so the tests above could only over-report misses).
-    let sphere = UvSphere::new(FAR, 100.0, 24, 48);
+    let sphere = UvSphere::new(FAR, 100.0, 24, 48, JITTER);
     let mut rng = Rng(7);
     let mut scratch = Vec::new();
     for _ in 0..20_000 {
@@ -200,7 +208,7 @@ fn the_candidate_cells_do_hold_the_hit() {
 #[test]
 fn rays_from_inside_an_instanced_sphere_never_miss() {
     // The same property through the world and an instance: the ray is moved into mesh space.
-    let sphere = UvSphere::new(Vec3::ZERO, 1.0, 16, 32);
+    let sphere = UvSphere::new(Vec3::ZERO, 1.0, 16, 32, JITTER);
     let mesh = Arc::new(sphere.mesh);
     let place = Affine3A::from_scale_rotation_translation(Vec3::splat(100.0), glam::Quat::from_rotation_z(0.4), FAR);
     let world = World::build(vec![Instance::new(mesh, place).unwrap().into()], AccelKind::None).unwrap();
@@ -210,5 +218,28 @@ fn rays_from_inside_an_instanced_sphere_never_miss() {
         let ray = Ray::new(origin, rng.in_ball().normalize().as_vec3());
         assert!(world.closest_hit(&ray, &mut NoCount).is_some(), "{ray:?}");
         assert!(world.any_hit(&ray, &mut NoCount));
+    }
+}
+
+#[test]
+fn every_structure_finds_the_jittered_sphere_from_inside() {
+    // The same rays through the world, with every structure: a structure must not lose through
+    // its boxes what the triangle test finds. A million random rays from inside and the rays at
+    // every vertex and edge midpoint, at the origin and far from it. The seed's two BVHs, whose
+    // traversal visits thousands of nodes per ray on a mesh this size, take every 100th ray.
+    for (center, radius, seed) in [(Vec3::ZERO, 1.0, 0x243F_6A88_85A3_08D3), (FAR, 100.0, 0x1319_8A2E_0370_7344)] {
+        let sphere = UvSphere::new(center, radius, 128, 256, JITTER);
+        let mut rays: Vec<Ray> = random_rays(&sphere, 1_000_000, seed).collect();
+        rays.extend(rays_at_vertices_and_edges(&sphere));
+        let mesh = Arc::new(sphere.mesh);
+        for &kind in AccelKind::ALL.iter().filter(|&&k| k != AccelKind::None) {
+            let world = World::build(vec![Object::Mesh(mesh.clone())], kind).unwrap();
+            let step = if matches!(kind, AccelKind::BvhSeed | AccelKind::BvhSeedOrdered) { 100 } else { 1 };
+            let rays: Vec<&Ray> = rays.iter().step_by(step).collect();
+            let misses = rays.par_iter().filter(|ray| world.closest_hit(ray, &mut NoCount).is_none()).count();
+            assert_eq!(misses, 0, "{kind} at {center}: {misses} of {} rays miss", rays.len());
+            let any_misses = rays.par_iter().filter(|ray| !world.any_hit(ray, &mut NoCount)).count();
+            assert_eq!(any_misses, 0, "{kind} at {center}: {any_misses} of {} any-hit queries miss", rays.len());
+        }
     }
 }

@@ -15,7 +15,7 @@
 //! density is lowered until both fit; at one cell the grid is brute force with a box.
 //!
 //! **Assignment.** A primitive is listed in every cell its box overlaps, boundaries included, with
-//! the box grown by a small margin (`2^-14` of the largest coordinate of the grid's box): where a
+//! the box grown by a small margin (`2^-18`, 32 units in the last place, of the largest coordinate of the grid's box): where a
 //! ray crosses near an edge or a corner of cells, rounding may order its crossings wrongly by that
 //! much, and a primitive touching that corner is then in whichever cell the traversal visits.
 //! Lists are filled in primitive order (so each is sorted) in two passes: count, then place.
@@ -35,7 +35,7 @@ use crate::accel::ClipFn;
 pub const MAX_AXIS_CELLS: u32 = 1 << 12;
 
 /// The margin of assignment, relative to the largest coordinate of the grid's box.
-const MARGIN_SCALE: f32 = 1.0 / (1 << 14) as f32;
+const MARGIN_SCALE: f32 = 1.0 / (1 << 18) as f32;
 
 /// Cells along each axis for `n` primitives in `bounds` (see the module documentation); at least
 /// one per axis, at most [`MAX_AXIS_CELLS`].
