@@ -8,7 +8,7 @@ mod common;
 
 use common::{check_all_structures, shared_dir};
 use englobe::accel::validate::validate_bvh;
-use englobe::{Aabb, AccelKind, AnyAccel, Bounded, Intersect, Ray, Shape, Sphere, Triangle, TriangleMesh, Vec3};
+use englobe::{Aabb, Accel, AccelKind, AnyAccel, Bounded, Intersect, Ray, Shape, Sphere, Triangle, TriangleMesh, Vec3};
 
 /// Most primitives per leaf of the SAH builders.
 const MAX_LEAF: usize = 8;
@@ -134,4 +134,59 @@ fn a_flat_mesh() {
         }
     }
     check_all_structures(&boxes, &rays, |i, r| mesh.intersect(i, r)).unwrap();
+}
+
+/// Memory and depth of every structure over `boxes`, clipping triangles exactly with `clip`:
+/// printed, and bounded.
+fn check_size(boxes: &[Aabb], clip: englobe::accel::ClipFn<'_>, max_depth: usize) {
+    for &kind in AccelKind::ALL {
+        let stats = AnyAccel::build_with_clipper(kind, boxes, clip).stats();
+        eprintln!("{kind}: {} bytes, depth {}", stats.memory_bytes, stats.depth);
+        // The grid's caps (2^26 references, 2^24 cells) bound it whatever the input; the kd-tree
+        // references a primitive from every leaf it overlaps, and here every primitive overlaps
+        // the centre (about 200 references each, bounded by the depth limit); the BVHs are linear.
+        let most = match kind {
+            AccelKind::Grid => (1 << 26) * 4 + (1 << 24) * 4 + 4096,
+            AccelKind::KdTree => 1024 * boxes.len() + 4096,
+            _ => 256 * boxes.len() + 4096,
+        };
+        assert!(stats.memory_bytes <= most, "{kind}: {} bytes for {} primitives", stats.memory_bytes, boxes.len());
+        assert!(stats.depth <= max_depth, "{kind}: depth {}", stats.depth);
+    }
+}
+
+#[test]
+fn a_hundred_thousand_copies_of_one_triangle() {
+    let (a, b, c) = (Vec3::new(1.0, 2.0, 3.0), Vec3::new(1.5, 2.0, 3.2), Vec3::new(1.2, 2.7, 2.9));
+    let mesh = TriangleMesh::new(vec![a, b, c], vec![[0, 1, 2]; 100_000]).unwrap();
+    let boxes: Vec<Aabb> = (0..mesh.len() as u32).map(|t| mesh.triangle_bounds(t)).collect();
+    let clip = |t: u32, cell: &Aabb| englobe::shapes::clip_triangle(mesh.triangle(t).vertices, cell);
+    check_size(&boxes, &clip, 64);
+    let rays = rays_around((a + b + c) / 3.0, 4.0);
+    common::check_all_structures_clipped(&boxes, &clip, &rays, |i, r| mesh.intersect(i, r)).unwrap();
+}
+
+#[test]
+fn seventy_thousand_triangles_with_one_centroid() {
+    // Triangles of every size and orientation around one point, whose centroid is that point.
+    let centre = Vec3::new(-2.0, 0.5, 7.0);
+    let mut positions = Vec::new();
+    let mut state = 0x2545_F491u64;
+    let mut next = || {
+        state = state.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
+        (state >> 40) as f32 / (1u64 << 24) as f32 - 0.5
+    };
+    for i in 0..70_000 {
+        let scale = 0.01 + i as f32 * 1e-4;
+        let u = Vec3::new(next(), next(), next()) * scale;
+        let v = Vec3::new(next(), next(), next()) * scale;
+        positions.extend([centre + u, centre + v, centre - u - v]);
+    }
+    let triangles = (0..70_000u32).map(|i| [3 * i, 3 * i + 1, 3 * i + 2]).collect();
+    let mesh = TriangleMesh::new(positions, triangles).unwrap();
+    let boxes: Vec<Aabb> = (0..mesh.len() as u32).map(|t| mesh.triangle_bounds(t)).collect();
+    let clip = |t: u32, cell: &Aabb| englobe::shapes::clip_triangle(mesh.triangle(t).vertices, cell);
+    check_size(&boxes, &clip, 128);
+    let rays = rays_around(centre, 30.0);
+    common::check_all_structures_clipped(&boxes, &clip, &rays, |i, r| mesh.intersect(i, r)).unwrap();
 }
