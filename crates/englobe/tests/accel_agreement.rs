@@ -273,3 +273,97 @@ fn a_tie_in_a_subtree_entered_exactly_at_the_hit() {
     assert_eq!(shapes[1].intersect(&ray).map(|h| h.t), Some(5.0));
     check(&shapes, &[ray]).unwrap();
 }
+
+/// A small deterministic generator for the exact-mode scenes (SplitMix64).
+struct Lattice(u64);
+
+impl Lattice {
+    fn int(&mut self, lo: i32, hi: i32) -> i32 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        lo + ((z ^ (z >> 31)) % (hi - lo + 1) as u64) as i32
+    }
+
+    fn point(&mut self) -> Vec3 {
+        Vec3::new(self.int(-4, 4) as f32, self.int(-4, 4) as f32, self.int(-4, 4) as f32)
+    }
+
+    /// Triangles and spheres with integer vertices, centres and radii.
+    fn scene(&mut self, n: usize) -> Vec<Shape> {
+        (0..n)
+            .map(|_| {
+                if self.int(0, 3) == 0 {
+                    Sphere::new(self.point(), self.int(1, 2) as f32).into()
+                } else {
+                    Triangle::new(self.point(), self.point(), self.point()).into()
+                }
+            })
+            .collect()
+    }
+
+    /// Rays from integer points along the axes (both signs) and the diagonals of a face.
+    fn axis_ray(&mut self) -> Ray {
+        let mut d = Vec3::ZERO;
+        d[self.int(0, 2) as usize] = if self.int(0, 1) == 0 { 1.0 } else { -1.0 };
+        if self.int(0, 2) == 0 {
+            d[(self.int(0, 2) as usize + 1) % 3] += if self.int(0, 1) == 0 { 1.0 } else { -1.0 };
+        }
+        let d = if d == Vec3::ZERO { Vec3::X } else { d };
+        Ray::new(Vec3::new(self.int(-6, 6) as f32, self.int(-6, 6) as f32, self.int(-6, 6) as f32), d)
+    }
+}
+
+/// Every primitive the ray hits anywhere along its interval, as `accel` finds them: its query is
+/// told that nothing was hit, so it never shortens the interval and must offer every primitive
+/// whose box the ray meets.
+fn hit_set(accel: &englobe::AnyAccel, shapes: &[Shape], ray: &Ray) -> std::collections::BTreeSet<u32> {
+    use englobe::Accel;
+    let mut hits = std::collections::BTreeSet::new();
+    accel.closest_hit(ray, &mut englobe::NoCount, |i, r| {
+        if shapes[i as usize].intersect(r).is_some() {
+            hits.insert(i);
+        }
+        None
+    });
+    hits
+}
+
+#[test]
+fn exact_mode_integer_scenes_and_axis_rays_find_the_same_sets_of_hit_primitives() {
+    let mut rng = Lattice(41);
+    let mut compared = 0;
+    for scene in 0..150 {
+        let shapes = rng.scene(1 + scene % 40);
+        let boxes: Vec<Aabb> = shapes.iter().map(Bounded::bounds).collect();
+        let clip = |i: u32, cell: &Aabb| match &shapes[i as usize] {
+            Shape::Triangle(t) => clip_triangle(t.vertices, cell),
+            s => s.bounds().intersection(cell),
+        };
+        let rays: Vec<Ray> = (0..40).map(|_| rng.axis_ray()).collect();
+        let brute = englobe::AnyAccel::build(englobe::AccelKind::None, &boxes);
+        let expected: Vec<_> = rays.iter().map(|r| hit_set(&brute, &shapes, r)).collect();
+        for &kind in englobe::AccelKind::ALL {
+            let accel = englobe::AnyAccel::build_with_clipper(kind, &boxes, &clip);
+            for (ray, want) in rays.iter().zip(&expected) {
+                assert_eq!(&hit_set(&accel, &shapes, ray), want, "{kind}, scene {scene}: {ray:?}");
+                compared += usize::from(!want.is_empty());
+            }
+        }
+        check(&shapes, &rays).unwrap();
+    }
+    assert!(compared > 10_000, "only {compared} rays hit anything");
+}
+
+#[test]
+fn every_size_from_0_to_64() {
+    // Builds over the first n primitives of one scene, for every n: no panic, valid structures
+    // (checked by the validators inside `check`), and the same answers as brute force.
+    let mut rng = Lattice(7);
+    let shapes = rng.scene(64);
+    let rays: Vec<Ray> = (0..24).map(|_| rng.axis_ray()).chain(star_rays()).collect();
+    for n in 0..=64 {
+        check(&shapes[..n], &rays).unwrap_or_else(|e| panic!("{n} primitives: {e}"));
+    }
+}
