@@ -81,6 +81,17 @@ fn one_and_two_threads_write_identical_bytes() {
     let a = std::fs::read(dir.path().join("one.png")).unwrap();
     let b = std::fs::read(dir.path().join("two.png")).unwrap();
     assert_eq!(a, b);
+    // And a second run, the path tracer's random sequences included.
+    let again = englobe(dir.path(), &[&common[..], &["--threads", "2", "-o", "again.png"]].concat());
+    assert!(again.status.success());
+    assert_eq!(a, std::fs::read(dir.path().join("again.png")).unwrap());
+    for name in ["path-1.png", "path-2.png"] {
+        let path = englobe(dir.path(), &[&common[..], &["--integrator", "path", "-o", name]].concat());
+        assert!(path.status.success(), "{}", stderr(&path));
+    }
+    let (p1, p2) =
+        (std::fs::read(dir.path().join("path-1.png")).unwrap(), std::fs::read(dir.path().join("path-2.png")));
+    assert_eq!(p1, p2.unwrap());
 }
 
 #[test]
