@@ -12,25 +12,12 @@
 
 mod common;
 
-use common::shared_dir;
+use common::load_obj;
 use englobe::accel::grid::stats::validate_grid_clipped;
 use englobe::accel::kdtree::stats::validate_kdtree;
 use englobe::accel::{Grid, GridParams, KdTree, KdTreeParams};
 use englobe::shapes::clip_triangle;
 use englobe::{Aabb, Accel, AccelKind, AnyAccel, Ray, TriangleMesh, Vec3, WorkCounts};
-
-fn load_obj(relative: &str) -> TriangleMesh {
-    let path = shared_dir().join(relative);
-    let (models, _) = tobj::load_obj(&path, &tobj::GPU_LOAD_OPTIONS)
-        .unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()));
-    let (mut positions, mut triangles) = (Vec::new(), Vec::new());
-    for m in models {
-        let base = positions.len() as u32;
-        positions.extend(m.mesh.positions.chunks_exact(3).map(|p| Vec3::new(p[0], p[1], p[2])));
-        triangles.extend(m.mesh.indices.chunks_exact(3).map(|t| [base + t[0], base + t[1], base + t[2]]));
-    }
-    TriangleMesh::new(positions, triangles).expect("a valid mesh")
-}
 
 /// `n` random triangles of size `size` with centres in the cube `[-half, half]^3`.
 fn soup(n: usize, half: f32, size: f32) -> TriangleMesh {

@@ -6,7 +6,7 @@
 
 mod common;
 
-use common::{check_all_structures, shared_dir};
+use common::{check_all_structures, load_obj};
 use englobe::accel::validate::validate_bvh;
 use englobe::{Aabb, Accel, AccelKind, AnyAccel, Bounded, Intersect, Ray, Shape, Sphere, Triangle, TriangleMesh, Vec3};
 
@@ -108,16 +108,7 @@ fn zero_volume_boxes() {
 #[test]
 fn a_flat_mesh() {
     // woody.obj lies entirely in the plane z = 0.
-    let path = shared_dir().join("scenes/meshes/small/woody.obj");
-    let (models, _) = tobj::load_obj(&path, &tobj::GPU_LOAD_OPTIONS)
-        .unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()));
-    let (mut positions, mut triangles) = (Vec::new(), Vec::new());
-    for m in models {
-        let base = positions.len() as u32;
-        positions.extend(m.mesh.positions.chunks_exact(3).map(|p| Vec3::new(p[0], p[1], p[2])));
-        triangles.extend(m.mesh.indices.chunks_exact(3).map(|t| [base + t[0], base + t[1], base + t[2]]));
-    }
-    let mesh = TriangleMesh::new(positions, triangles).expect("a valid mesh");
+    let mesh = load_obj("scenes/meshes/small/woody.obj");
     let bounds = mesh.bounds();
     assert_eq!(bounds.min.z, bounds.max.z, "the mesh is flat");
     let boxes: Vec<Aabb> = (0..mesh.len() as u32).map(|t| mesh.triangle_bounds(t)).collect();

@@ -15,6 +15,12 @@
 //! never change during a query and its `t_max` only shrinks, so a primitive that missed once
 //! misses again, and one that was hit has already been offered to the query's record.
 
+use std::ops::ControlFlow;
+
+use super::{Counters, HitRecord};
+use crate::Ray;
+use crate::shapes::PrimHit;
+
 /// Entries of the table (a power of two).
 pub const MAILBOX_SLOTS: usize = 64;
 
@@ -52,6 +58,50 @@ impl Mailbox {
             *entry = prim;
             false
         }
+    }
+
+    /// The closest-hit query's work in one leaf or cell: offers every primitive of `prims` not
+    /// yet tested to `record`, and returns how far the walk must go on (the closest hit so far).
+    #[inline(always)]
+    pub fn closest_in<C: Counters>(
+        &mut self,
+        prims: &[u32],
+        record: &mut HitRecord,
+        counters: &mut C,
+        intersect: &mut impl FnMut(u32, &Ray) -> Option<PrimHit>,
+    ) -> ControlFlow<(), f32> {
+        for &prim in prims {
+            if self.already_tested(prim) {
+                continue;
+            }
+            counters.exact_test();
+            if let Some(hit) = intersect(prim, &record.ray) {
+                record.offer(prim, hit);
+            }
+        }
+        ControlFlow::Continue(record.ray.t_max)
+    }
+
+    /// The any-hit query's work in one leaf or cell: breaks at the first primitive of `prims`
+    /// not yet tested that occludes `ray`.
+    #[inline(always)]
+    pub fn any_in<C: Counters>(
+        &mut self,
+        prims: &[u32],
+        ray: &Ray,
+        counters: &mut C,
+        occludes: &mut impl FnMut(u32, &Ray) -> bool,
+    ) -> ControlFlow<(), f32> {
+        for &prim in prims {
+            if self.already_tested(prim) {
+                continue;
+            }
+            counters.exact_test();
+            if occludes(prim, ray) {
+                return ControlFlow::Break(());
+            }
+        }
+        ControlFlow::Continue(ray.t_max)
     }
 }
 

@@ -1,6 +1,6 @@
 //! Shared by the cross-structure tests: one check that runs every structure of
 //! [`AccelKind::ALL`] against brute force (the kd-tree both with the caller's clipping and with
-//! plain boxes), and the shared data folder.
+//! plain boxes), and the shared data folder and its meshes.
 
 #![allow(dead_code)]
 
@@ -107,4 +107,19 @@ pub fn shared_dir() -> PathBuf {
     manifest.ancestors().map(|a| a.join("shared")).find(|s| s.join("scenes").is_dir()).unwrap_or_else(|| {
         panic!("no shared/scenes folder beside any ancestor of {}; set ENGLOBE_SHARED", manifest.display())
     })
+}
+
+/// A mesh of the shared data folder (`relative` to it), read with tobj and triangulated, its
+/// groups merged into one mesh.
+pub fn load_obj(relative: &str) -> englobe::TriangleMesh {
+    let path = shared_dir().join(relative);
+    let (models, _) = tobj::load_obj(&path, &tobj::GPU_LOAD_OPTIONS)
+        .unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()));
+    let (mut positions, mut triangles) = (Vec::new(), Vec::new());
+    for m in models {
+        let base = positions.len() as u32;
+        positions.extend(m.mesh.positions.chunks_exact(3).map(|p| englobe::Vec3::new(p[0], p[1], p[2])));
+        triangles.extend(m.mesh.indices.chunks_exact(3).map(|t| [base + t[0], base + t[1], base + t[2]]));
+    }
+    englobe::TriangleMesh::new(positions, triangles).expect("a valid mesh")
 }

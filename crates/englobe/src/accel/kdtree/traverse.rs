@@ -133,18 +133,7 @@ impl KdTree {
     ) -> Option<Hit> {
         let mut record = HitRecord::new(*ray);
         let mut mailbox = Mailbox::new(self.mailbox);
-        self.walk(ray, counters, |prims, counters| {
-            for &prim in prims {
-                if mailbox.already_tested(prim) {
-                    continue;
-                }
-                counters.exact_test();
-                if let Some(hit) = intersect(prim, &record.ray) {
-                    record.offer(prim, hit);
-                }
-            }
-            ControlFlow::Continue(record.ray.t_max)
-        });
+        self.walk(ray, counters, |prims, counters| mailbox.closest_in(prims, &mut record, counters, &mut intersect));
         record.hit
     }
 
@@ -160,17 +149,9 @@ impl KdTree {
         let mut occluded = false;
         let mut mailbox = Mailbox::new(self.mailbox);
         self.walk(ray, counters, |prims, counters| {
-            for &prim in prims {
-                if mailbox.already_tested(prim) {
-                    continue;
-                }
-                counters.exact_test();
-                if occludes(prim, ray) {
-                    occluded = true;
-                    return ControlFlow::Break(());
-                }
-            }
-            ControlFlow::Continue(ray.t_max)
+            let flow = mailbox.any_in(prims, ray, counters, &mut occludes);
+            occluded |= flow.is_break();
+            flow
         });
         occluded
     }
