@@ -1,5 +1,6 @@
 //! Degenerate inputs for every structure of `AccelKind::ALL`: 100 000 primitives with one common
-//! centre (identical, and nested by size, the worst case of agglomerative clustering), boxes of
+//! centre (identical spheres, 100 000 copies of one triangle, spheres nested by size, the worst
+//! case of agglomerative clustering, and 70 000 triangles around one centroid), boxes of
 //! zero volume (points and segments), and a completely flat mesh. Every one must build without a
 //! panic, a stack overflow or a quadratic blow-up, give a valid tree with small leaves and a
 //! bounded depth, and agree with brute force.
@@ -8,7 +9,9 @@ mod common;
 
 use common::{check_all_structures, load_obj};
 use englobe::accel::validate::validate_bvh;
-use englobe::{Aabb, Accel, AccelKind, AnyAccel, Bounded, Intersect, Ray, Shape, Sphere, Triangle, TriangleMesh, Vec3};
+use englobe::{
+    Aabb, Accel, AccelKind, AnyAccel, Bounded, Intersect, NoCount, Ray, Shape, Sphere, Triangle, TriangleMesh, Vec3,
+};
 
 /// Most primitives per leaf of the SAH builders.
 const MAX_LEAF: usize = 8;
@@ -127,22 +130,44 @@ fn a_flat_mesh() {
     check_all_structures(&boxes, &rays, |i, r| mesh.intersect(i, r)).unwrap();
 }
 
-/// Memory and depth of every structure over `boxes`, clipping triangles exactly with `clip`:
-/// printed, and bounded.
-fn check_size(boxes: &[Aabb], clip: englobe::accel::ClipFn<'_>, max_depth: usize) {
+/// Builds every structure over `boxes` once (triangles clipped exactly with `clip`), bounds its
+/// memory and depth, and compares its answers on `rays` with brute force's.
+fn check_size_and_answers(
+    boxes: &[Aabb],
+    clip: englobe::accel::ClipFn<'_>,
+    rays: &[Ray],
+    intersect: impl Fn(u32, &Ray) -> Option<englobe::PrimHit> + Copy,
+    max_depth: usize,
+) {
+    let brute = AnyAccel::build(AccelKind::None, boxes);
+    let expected: Vec<_> = rays
+        .iter()
+        .map(|r| {
+            (
+                brute.closest_hit(r, &mut NoCount, intersect),
+                brute.any_hit(r, &mut NoCount, |i, r| intersect(i, r).is_some()),
+            )
+        })
+        .collect();
     for &kind in AccelKind::ALL {
-        let stats = AnyAccel::build_with_clipper(kind, boxes, clip).stats();
-        eprintln!("{kind}: {} bytes, depth {}", stats.memory_bytes, stats.depth);
-        // The grid's caps (2^26 references, 2^24 cells) bound it whatever the input; the kd-tree
-        // references a primitive from every leaf it overlaps, and here every primitive overlaps
-        // the centre (about 200 references each, bounded by the depth limit); the BVHs are linear.
+        let accel = AnyAccel::build_with_clipper(kind, boxes, clip);
+        let stats = accel.stats();
+        // The grid's caps (64 references per primitive, 2^24 cells) bound it whatever the input;
+        // the kd-tree references a primitive from every leaf it overlaps, and here every
+        // primitive overlaps the centre (about 200 references each, bounded by the depth limit);
+        // the BVHs are linear.
         let most = match kind {
-            AccelKind::Grid => (1 << 26) * 4 + (1 << 24) * 4 + 4096,
+            AccelKind::Grid => 64 * 4 * boxes.len() + (1 << 24) * 4 + 4096,
             AccelKind::KdTree => 1024 * boxes.len() + 4096,
             _ => 256 * boxes.len() + 4096,
         };
         assert!(stats.memory_bytes <= most, "{kind}: {} bytes for {} primitives", stats.memory_bytes, boxes.len());
         assert!(stats.depth <= max_depth, "{kind}: depth {}", stats.depth);
+        for (ray, (closest, any)) in rays.iter().zip(&expected) {
+            let got = accel.closest_hit(ray, &mut NoCount, intersect);
+            assert_eq!(got.map(|h| (h.prim, h.t)), closest.map(|h| (h.prim, h.t)), "{kind}: {ray:?}");
+            assert_eq!(accel.any_hit(ray, &mut NoCount, |i, r| intersect(i, r).is_some()), *any, "{kind}: {ray:?}");
+        }
     }
 }
 
@@ -152,9 +177,8 @@ fn a_hundred_thousand_copies_of_one_triangle() {
     let mesh = TriangleMesh::new(vec![a, b, c], vec![[0, 1, 2]; 100_000]).unwrap();
     let boxes: Vec<Aabb> = (0..mesh.len() as u32).map(|t| mesh.triangle_bounds(t)).collect();
     let clip = |t: u32, cell: &Aabb| englobe::shapes::clip_triangle(mesh.triangle(t).vertices, cell);
-    check_size(&boxes, &clip, 64);
     let rays = rays_around((a + b + c) / 3.0, 4.0);
-    common::check_all_structures_clipped(&boxes, &clip, &rays, |i, r| mesh.intersect(i, r)).unwrap();
+    check_size_and_answers(&boxes, &clip, &rays, |i, r| mesh.intersect(i, r), 64);
 }
 
 #[test]
@@ -177,7 +201,6 @@ fn seventy_thousand_triangles_with_one_centroid() {
     let mesh = TriangleMesh::new(positions, triangles).unwrap();
     let boxes: Vec<Aabb> = (0..mesh.len() as u32).map(|t| mesh.triangle_bounds(t)).collect();
     let clip = |t: u32, cell: &Aabb| englobe::shapes::clip_triangle(mesh.triangle(t).vertices, cell);
-    check_size(&boxes, &clip, 128);
     let rays = rays_around(centre, 30.0);
-    common::check_all_structures_clipped(&boxes, &clip, &rays, |i, r| mesh.intersect(i, r)).unwrap();
+    check_size_and_answers(&boxes, &clip, &rays, |i, r| mesh.intersect(i, r), 128);
 }

@@ -11,7 +11,8 @@
 //!
 //! **Limits.** A grid over a large scene can exhaust memory ("memory-hungry", the seed report
 //! says): one big primitive overlaps many cells. The number of cells ([`GridParams::max_cells`])
-//! and the number of references ([`GridParams::max_refs`]) are computed, not allocated, and the
+//! and the number of references ([`GridParams::max_refs`], and at most
+//! [`GridParams::max_refs_per_prim`] per primitive) are computed, not allocated, and the
 //! density is lowered until both fit; at one cell the grid is brute force with a box.
 //!
 //! **Assignment.** A primitive is listed in every cell its box overlaps, boundaries included, with
@@ -138,8 +139,9 @@ fn has_box(b: &Aabb) -> bool {
 
 pub(super) fn build(boxes: &[Aabb], clip: Option<ClipFn<'_>>, params: GridParams) -> Grid {
     let max_cells = params.max_cells.clamp(1, 1 << 30);
-    let max_refs = params.max_refs.clamp(1, u32::MAX as u64 - 1);
     let (bounds, n) = boxes.iter().filter(|b| has_box(b)).fold((Aabb::EMPTY, 0usize), |(u, n), b| (u.union(b), n + 1));
+    let per_prim = params.max_refs_per_prim.max(1).saturating_mul(n as u64);
+    let max_refs = params.max_refs.min(per_prim).clamp(1, u32::MAX as u64 - 1);
     if n == 0 {
         return Grid {
             bounds: Aabb::EMPTY,
@@ -286,10 +288,12 @@ mod tests {
     fn the_reference_cap_lowers_the_resolution_down_to_one_cell() {
         // Big overlapping boxes: every one of them overlaps most cells.
         let boxes: Vec<Aabb> = (0..200).map(|i| cube(Vec3::splat(i as f32 * 0.01), 10.0)).collect();
-        let loose = Grid::build(&boxes);
+        let loose = Grid::build_with(&boxes, GridParams { max_refs_per_prim: u64::MAX, ..GridParams::default() });
         assert!(loose.refs.len() > 10_000);
         let capped = Grid::build_with(&boxes, GridParams { max_refs: 1000, ..GridParams::default() });
         assert!(capped.refs.len() <= 1000, "{}", capped.refs.len());
+        let per_prim = Grid::build(&boxes);
+        assert!(per_prim.refs.len() <= 64 * 200 && per_prim.cell_count() > 1, "{}", per_prim.refs.len());
         let tiny = Grid::build_with(&boxes, GridParams { max_refs: 10, ..GridParams::default() });
         assert_eq!((tiny.cell_count(), tiny.refs.len()), (1, 200), "one cell holds everything, whatever the cap");
     }
@@ -299,7 +303,10 @@ mod tests {
         let boxes: Vec<Aabb> = (0..10).map(|i| cube(Vec3::splat(i as f32), 0.5)).collect();
         let g = Grid::build_with(&boxes, GridParams { lambda: 1e30, ..GridParams::default() });
         assert!(g.cell_count() as u64 <= GridParams::default().max_cells);
-        let g = Grid::build_with(&boxes, GridParams { lambda: 0.0, max_cells: 0, max_refs: 0, mailbox: true });
+        let g = Grid::build_with(
+            &boxes,
+            GridParams { lambda: 0.0, max_cells: 0, max_refs: 0, max_refs_per_prim: 0, mailbox: true },
+        );
         assert_eq!(g.cell_count(), 1);
         let g = Grid::build_with(&boxes, GridParams { lambda: f32::NAN, ..GridParams::default() });
         assert_eq!(g.cell_count(), 1);

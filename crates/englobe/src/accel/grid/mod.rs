@@ -37,6 +37,10 @@ pub struct GridParams {
     /// Most references in all cells' lists (the resolution is lowered until they fit, down to a
     /// single cell). At most `2^32 - 2`.
     pub max_refs: u64,
+    /// Most references per primitive, on average (the resolution is lowered until they fit). A
+    /// grid is worthless once primitives pile up on each other (100 000 copies of one triangle):
+    /// this keeps its build and its memory linear in the primitives there.
+    pub max_refs_per_prim: u64,
     /// Skip primitives a query has already tested in an earlier cell (see
     /// [`crate::accel::mailbox`]); off only to measure what it saves.
     pub mailbox: bool,
@@ -44,7 +48,7 @@ pub struct GridParams {
 
 impl Default for GridParams {
     fn default() -> Self {
-        GridParams { lambda: 3.0, max_cells: 1 << 24, max_refs: 1 << 26, mailbox: true }
+        GridParams { lambda: 3.0, max_cells: 1 << 24, max_refs: 1 << 26, max_refs_per_prim: 64, mailbox: true }
     }
 }
 
