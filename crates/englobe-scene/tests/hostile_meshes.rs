@@ -337,3 +337,21 @@ fn unknown_missing_and_directory_paths_are_clear_errors() {
     assert!(e.to_string().contains("directory"), "{e}");
     assert!(matches!(refused(dir.path(), "x.stl", b"solid").kind, MeshErrorKind::UnknownFormat(_)));
 }
+
+#[test]
+fn a_gltf_buffer_that_cannot_be_read_is_named_with_the_gltf_file() {
+    // Found by fuzzing: a buffer uri naming a missing file gave an error naming only that file.
+    let dir = tempfile::tempdir().unwrap();
+    let path = gltf_triangle(dir.path(), [0, 1, 2], |doc| doc["buffers"][0]["uri"] = "missing.lin".into());
+    let e = load_mesh_file(&path).unwrap_err();
+    assert_eq!(e.path, path);
+    assert_eq!(json_at(&e), "buffers[0].uri");
+    let MeshErrorKind::Referenced(inner) = &e.kind else { panic!("{e}") };
+    assert!(matches!(inner.kind, MeshErrorKind::Io(_)), "{e}");
+    assert_eq!(inner.path, dir.path().join("missing.lin"));
+    let shown = e.to_string();
+    assert!(
+        shown.starts_with(&format!("{}: buffers[0].uri: ", path.display())) && shown.contains("missing.lin"),
+        "{shown}"
+    );
+}

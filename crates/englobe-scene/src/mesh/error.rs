@@ -48,6 +48,9 @@ pub enum MeshErrorKind {
     /// The file is part of a mesh but not a mesh itself (a material library, a buffer).
     #[error("{0}")]
     NotAMesh(String),
+    /// A file this one refers to (a glTF buffer) could not be used; the inner error names it.
+    #[error("{0}")]
+    Referenced(Box<MeshFileError>),
     /// Text that should be a number is not one.
     #[error("`{token}` is not {expected}")]
     BadNumber {

@@ -85,7 +85,11 @@ impl<'a> Buffers<'a> {
                 }
                 Some(uri) => {
                     let file = self.path.parent().unwrap_or(Path::new("")).join(percent_decode(uri));
-                    Cow::Owned(read_limited(&file, MAX_MESH_FILE_BYTES)?)
+                    // The error names the glTF file and the buffer, then the file it points to.
+                    let referenced = |e| {
+                        json_err(self.path, format!("buffers[{index}].uri"), MeshErrorKind::Referenced(Box::new(e)))
+                    };
+                    Cow::Owned(read_limited(&file, MAX_MESH_FILE_BYTES).map_err(referenced)?)
                 }
             };
             if (data.len() as u64) < def.byte_length.0 {
