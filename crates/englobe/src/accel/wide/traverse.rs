@@ -1,0 +1,216 @@
+//! Single-ray traversal of the wide BVH: all eight children of a node tested at once, the hit
+//! ones entered nearest first, the others kept on a stack with their entry distances and dropped
+//! without another test if a closer hit is found before they are popped. This is the traversal
+//! of Wald, Benthin and Boulos (2008), "Getting Rid of Packets: Efficient SIMD Single-Ray
+//! Traversal using Multi-branching BVHs", in the form Embree's `BVHNIntersector1` gives it (Wald
+//! et al. 2014): no sorting at all when one child or two are hit (the common cases), a short
+//! insertion sort of the hit children otherwise.
+//!
+//! Occlusion queries stop at the first occluder and do not sort: distance order only pays when
+//! the query must find the nearest hit.
+//!
+//! The traversal is generic over the node test ([`NodeKernel`], one per instruction set) and over
+//! what leaves hold ([`Leaves`]: primitive references tested by a closure, or blocks of
+//! triangles). [`dispatch`] calls the instance compiled for the structure's instruction set.
+//!
+//! The stack holds at most seven entries per level of the path from the root, so the tree's
+//! recorded depth bounds it: trees up to [`INLINE_DEPTH`] levels deep use an uninitialised array on
+//! the call stack (no per-query cost to clear it); deeper ones (only degenerate builds are) a buffer
+//! kept per thread and grown once. No query allocates in the steady state.
+
+use std::cell::Cell;
+use std::mem::MaybeUninit;
+
+use super::kernels::NodeKernel;
+use super::node::{NodeRay, WIDTH, WideNode, index_of, is_leaf, reach};
+use crate::accel::Counters;
+
+/// Depth (in wide nodes) up to which the stack lives on the call stack.
+pub const INLINE_DEPTH: usize = 32;
+/// Entries of the inline stack.
+const INLINE_ENTRIES: usize = (WIDTH - 1) * INLINE_DEPTH + 1;
+
+/// A pending child: its reference, its leaf item count, and the distance at which the ray enters
+/// its box.
+#[derive(Clone, Copy, Debug)]
+pub struct Entry {
+    reference: u32,
+    count: u32,
+    t: f32,
+}
+
+/// What the leaves of a wide BVH hold, and how a query tests them.
+pub trait Leaves<C: Counters> {
+    /// Tests the `count` items from `first` for the closest hit, shrinking the interval.
+    fn closest(&mut self, first: u32, count: u32, counters: &mut C);
+    /// The end of the interval: the closest hit so far, or the ray's `t_max`.
+    fn t_max(&self) -> f32;
+    /// Whether any of the `count` items from `first` is hit.
+    fn any(&mut self, first: u32, count: u32, counters: &mut C) -> bool;
+}
+
+thread_local! {
+    /// The stack of queries on trees deeper than [`INLINE_DEPTH`], reused from query to query. A
+    /// query nested inside another's closure finds it taken and uses a fresh one.
+    static DEEP_STACK: Cell<Vec<MaybeUninit<Entry>>> = const { Cell::new(Vec::new()) };
+}
+
+/// Runs `query` with a stack of at least `(WIDTH - 1) * depth + 1` entries: each level of the
+/// path pushes at most seven, and the deepest briefly holds all eight of its children.
+#[inline(always)]
+pub fn with_stack<R>(depth: u32, query: impl FnOnce(&mut [MaybeUninit<Entry>]) -> R) -> R {
+    let needed = (WIDTH - 1) * depth as usize + 1;
+    if needed <= INLINE_ENTRIES {
+        let mut inline = [const { MaybeUninit::<Entry>::uninit() }; INLINE_ENTRIES];
+        query(&mut inline)
+    } else {
+        let mut stack = DEEP_STACK.with(Cell::take);
+        stack.resize(needed.max(stack.len()), MaybeUninit::uninit());
+        let result = query(&mut stack);
+        DEEP_STACK.with(|kept| kept.set(stack));
+        result
+    }
+}
+
+/// The closest hit: walks the tree from the root (node 0 of a non-empty `nodes`), asking `leaves`
+/// to test the leaves the ray reaches, nearest first.
+///
+/// # Safety
+/// As [`NodeKernel::children`]: compiled with the kernel's target features, run on a processor
+/// that has them.
+#[inline(always)]
+pub unsafe fn closest<K: NodeKernel, C: Counters, L: Leaves<C>>(
+    kernel: K,
+    nodes: &[WideNode],
+    depth: u32,
+    ray: &NodeRay,
+    leaves: &mut L,
+    counters: &mut C,
+) {
+    with_stack(depth, |stack| {
+        let mut len = 0usize;
+        let mut dist = [0.0f32; WIDTH];
+        let mut current = Entry { reference: 0, count: 0, t: 0.0 };
+        loop {
+            if is_leaf(current.reference) {
+                leaves.closest(index_of(current.reference), current.count, counters);
+            } else {
+                let node = &nodes[current.reference as usize];
+                counters.node_visited();
+                counters.box_tests(WIDTH as u32);
+                // SAFETY: the caller's guarantee.
+                let mut mask = unsafe { kernel.children(node, ray, reach(leaves.t_max()), &mut dist) };
+                if mask != 0 {
+                    let first = mask.trailing_zeros() as usize;
+                    mask &= mask - 1;
+                    let a = Entry { reference: node.children[first], count: node.counts[first] as u32, t: dist[first] };
+                    if mask == 0 {
+                        current = a;
+                        continue;
+                    }
+                    let second = mask.trailing_zeros() as usize;
+                    mask &= mask - 1;
+                    let b = Entry { reference: node.children[second], count: node.counts[second] as u32, t: dist[second] };
+                    if mask == 0 {
+                        let (near, far) = if b.t < a.t { (b, a) } else { (a, b) };
+                        stack[len].write(far);
+                        len += 1;
+                        current = near;
+                        continue;
+                    }
+                    // Three or more: push them all, sort the pushed ones farthest first (an
+                    // insertion sort of at most eight), and take the nearest off the top.
+                    let base = len;
+                    stack[len].write(a);
+                    stack[len + 1].write(b);
+                    len += 2;
+                    while mask != 0 {
+                        let i = mask.trailing_zeros() as usize;
+                        mask &= mask - 1;
+                        stack[len].write(Entry { reference: node.children[i], count: node.counts[i] as u32, t: dist[i] });
+                        len += 1;
+                    }
+                    for i in base + 1..len {
+                        // SAFETY: entries below `len` were written.
+                        let e = unsafe { stack[i].assume_init() };
+                        let mut j = i;
+                        while j > base && unsafe { stack[j - 1].assume_init() }.t < e.t {
+                            stack[j] = stack[j - 1];
+                            j -= 1;
+                        }
+                        stack[j].write(e);
+                    }
+                    len -= 1;
+                    // SAFETY: written above.
+                    current = unsafe { stack[len].assume_init() };
+                    continue;
+                }
+            }
+            // Next pending child the ray still enters before the closest hit.
+            loop {
+                if len == 0 {
+                    return;
+                }
+                len -= 1;
+                // SAFETY: entries below `len` were written.
+                let e = unsafe { stack[len].assume_init() };
+                if e.t <= reach(leaves.t_max()) {
+                    current = e;
+                    break;
+                }
+            }
+        }
+    })
+}
+
+/// Whether any leaf item is hit: stops at the first one `leaves` reports.
+///
+/// # Safety
+/// As [`closest`].
+#[inline(always)]
+pub unsafe fn any<K: NodeKernel, C: Counters, L: Leaves<C>>(
+    kernel: K,
+    nodes: &[WideNode],
+    depth: u32,
+    ray: &NodeRay,
+    limit: f32,
+    leaves: &mut L,
+    counters: &mut C,
+) -> bool {
+    with_stack(depth, |stack| {
+        let mut len = 0usize;
+        let mut dist = [0.0f32; WIDTH];
+        let mut current = Entry { reference: 0, count: 0, t: 0.0 };
+        loop {
+            if is_leaf(current.reference) {
+                if leaves.any(index_of(current.reference), current.count, counters) {
+                    return true;
+                }
+            } else {
+                let node = &nodes[current.reference as usize];
+                counters.node_visited();
+                counters.box_tests(WIDTH as u32);
+                // SAFETY: the caller's guarantee.
+                let mut mask = unsafe { kernel.children(node, ray, limit, &mut dist) };
+                if mask != 0 {
+                    let first = mask.trailing_zeros() as usize;
+                    mask &= mask - 1;
+                    while mask != 0 {
+                        let i = mask.trailing_zeros() as usize;
+                        mask &= mask - 1;
+                        stack[len].write(Entry { reference: node.children[i], count: node.counts[i] as u32, t: 0.0 });
+                        len += 1;
+                    }
+                    current = Entry { reference: node.children[first], count: node.counts[first] as u32, t: 0.0 };
+                    continue;
+                }
+            }
+            if len == 0 {
+                return false;
+            }
+            len -= 1;
+            // SAFETY: entries below `len` were written.
+            current = unsafe { stack[len].assume_init() };
+        }
+    })
+}
