@@ -173,16 +173,17 @@ mod tests {
         for isa in Isa::available() {
             let mut hits = 0;
             for _ in 0..20_000 {
+                let children = 1 + next(WIDTH as u32) as usize;
+                let t_max = [f32::INFINITY, 1.0, 2.5][next(3) as usize];
                 let mut pick = |v: &[f32]| v[next(v.len() as u32) as usize];
                 let mut node = WideNode::EMPTY_NODE;
-                for slot in 0..(1 + next(WIDTH as u32)) as usize {
+                for slot in 0..children {
                     let a = Vec3::new(pick(&values), pick(&values), pick(&values));
                     let b = Vec3::new(pick(&values), pick(&values), pick(&values));
                     node.set_child(slot, &Aabb::new(a.min(b), a.max(b)), slot as u32, 0);
                 }
                 let origin = Vec3::new(pick(&values), pick(&values), pick(&values)) * 1.5;
                 let dir = Vec3::new(pick(&dirs), pick(&dirs), pick(&dirs));
-                let t_max = [f32::INFINITY, 1.0, 2.5][next(3) as usize];
                 hits += check(isa, &node, &Ray::segment(origin, dir, 0.0, t_max));
             }
             assert!(hits > 10_000, "{isa}: {hits}");
