@@ -15,7 +15,7 @@ use crate::agreement::{self, Mismatches, Reference};
 use crate::cli::BenchArgs;
 use crate::library::{BuildSettings, Library, LibraryKind, RayResult, build_library};
 use crate::measure::{self, Answers, CHUNK};
-use crate::rays::{self, RaySetKind, RaySets};
+use crate::rays::{self, RayParams, RaySetKind, RaySets};
 use crate::report::{self, Cell};
 use crate::results::{self, Measurement};
 use crate::scene::BenchScene;
@@ -44,7 +44,8 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<ExitCode> {
     for spec in &args.scenes {
         let scene = BenchScene::load(&spec.name, &spec.path, spec.tiling)?;
         progress(format!("{}: {} triangles; generating rays", scene.name, scene.triangle_count()));
-        let sets = generate_rays(&scene, args, max_threads)?;
+        let params = RayParams { resolution: args.resolution, count: args.rays, seed: args.seed };
+        let sets = generate_rays(&scene, params, max_threads)?;
         let references = if args.no_check {
             BTreeMap::new()
         } else {
@@ -120,9 +121,9 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<ExitCode> {
 
 /// The three ray sets; the bounce rays start from the primary hits found with englobe's best
 /// structure (every englobe structure gives brute force's answers exactly).
-pub fn generate_rays(scene: &BenchScene, args: &BenchArgs, threads: usize) -> anyhow::Result<RaySets> {
-    let primary = rays::primary_rays(scene, args.resolution);
-    let random = rays::random_rays(scene, args.rays, args.seed);
+pub fn generate_rays(scene: &BenchScene, params: RayParams, threads: usize) -> anyhow::Result<RaySets> {
+    let primary = rays::primary_rays(scene, params.resolution);
+    let random = rays::random_rays(scene, params.count, params.seed);
     let pool = measure::thread_pool(threads)?;
     let hits = pool.install(|| -> anyhow::Result<Vec<RayResult>> {
         let englobe = EnglobeLibrary::build(scene, EnglobeStructure::best())?;
@@ -133,7 +134,7 @@ pub fn generate_rays(scene: &BenchScene, args: &BenchArgs, threads: usize) -> an
             .for_each(|(rays, out)| englobe.closest_hits(rays, out));
         Ok(hits)
     })?;
-    let bounce = rays::bounce_rays(scene, &primary, &hits, args.rays, args.seed);
+    let bounce = rays::bounce_rays(scene, &primary, &hits, params.count, params.seed);
     if bounce.is_empty() {
         bail!("{}: no primary ray hits the mesh, so there are no bounce rays", scene.name);
     }

@@ -45,6 +45,13 @@ impl EnglobeStructure {
     }
 }
 
+impl Default for EnglobeStructure {
+    /// The best structure available ([`EnglobeStructure::best`]).
+    fn default() -> Self {
+        Self::best()
+    }
+}
+
 impl fmt::Display for EnglobeStructure {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(&self.name())
