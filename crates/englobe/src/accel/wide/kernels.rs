@@ -186,7 +186,8 @@ mod tests {
                 let dir = Vec3::new(pick(&dirs), pick(&dirs), pick(&dirs));
                 hits += check(isa, &node, &Ray::segment(origin, dir, 0.0, t_max));
             }
-            assert!(hits > 10_000, "{isa}: {hits}");
+            // About one box in fourteen is entered: enough of both outcomes.
+            assert!(hits > 3_000, "{isa}: {hits}");
         }
     }
 }
