@@ -6,23 +6,10 @@
 
 mod common;
 
-use common::{check_all_structures_clipped, shared_dir};
+use common::{check_all_structures_clipped, load_obj};
 use englobe::accel::validate::validate_bvh;
 use englobe::shapes::clip_triangle;
-use englobe::{Aabb, Accel, AccelKind, AnyAccel, NoCount, Ray, TriangleMesh, Vec3, WorkCounts};
-
-fn load_obj(relative: &str) -> TriangleMesh {
-    let path = shared_dir().join(relative);
-    let (models, _) = tobj::load_obj(&path, &tobj::GPU_LOAD_OPTIONS)
-        .unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()));
-    let (mut positions, mut triangles) = (Vec::new(), Vec::new());
-    for m in models {
-        let base = positions.len() as u32;
-        positions.extend(m.mesh.positions.chunks_exact(3).map(|p| Vec3::new(p[0], p[1], p[2])));
-        triangles.extend(m.mesh.indices.chunks_exact(3).map(|t| [base + t[0], base + t[1], base + t[2]]));
-    }
-    TriangleMesh::new(positions, triangles).expect("a valid mesh")
-}
+use englobe::{Aabb, Accel, AccelKind, AnyAccel, NoCount, Ray, Vec3, WorkCounts};
 
 /// Deterministic rays from a sphere around `bounds` towards points inside it, plus axis-parallel
 /// rays on a grid across it.

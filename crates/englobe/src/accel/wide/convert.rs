@@ -54,7 +54,11 @@ pub struct WideLayout {
 enum Part {
     Node(u32),
     /// `prim_indices[start..start + len]`, inside a leaf with box `bounds`.
-    Range { start: u32, len: u32, bounds: Aabb },
+    Range {
+        start: u32,
+        len: u32,
+        bounds: Aabb,
+    },
 }
 
 /// Converts `bvh` into wide nodes, its leaves stored through `sink`.
@@ -95,7 +99,10 @@ pub fn convert(bvh: &Bvh, options: ConvertOptions, sink: &mut impl LeafSink) -> 
                     let r = n.prim_range();
                     let half = (r.len() / 2) as u32;
                     let (start, len, bounds) = (r.start as u32, r.len() as u32, n.bounds());
-                    [Part::Range { start, len: half, bounds }, Part::Range { start: start + half, len: len - half, bounds }]
+                    [
+                        Part::Range { start, len: half, bounds },
+                        Part::Range { start: start + half, len: len - half, bounds },
+                    ]
                 } else {
                     [Part::Node(i + 1), Part::Node(n.index)]
                 }
@@ -155,7 +162,9 @@ pub fn convert(bvh: &Bvh, options: ConvertOptions, sink: &mut impl LeafSink) -> 
 /// Appends the primitives under `part` to `out`, in the binary tree's leaf order.
 fn gather(bvh: &Bvh, part: &Part, out: &mut Vec<u32>) {
     match *part {
-        Part::Range { start, len, .. } => out.extend_from_slice(&bvh.prim_indices()[start as usize..(start + len) as usize]),
+        Part::Range { start, len, .. } => {
+            out.extend_from_slice(&bvh.prim_indices()[start as usize..(start + len) as usize])
+        }
         Part::Node(i) => {
             let mut stack = vec![i];
             while let Some(i) = stack.pop() {

@@ -78,7 +78,13 @@ impl WideBvh {
     pub fn from_bvh(bvh: &Bvh) -> Self {
         let mut sink = References(Vec::with_capacity(bvh.prim_indices().len()));
         let layout = convert(bvh, ConvertOptions { collapse: 0 }, &mut sink);
-        WideBvh { nodes: layout.nodes, prim_indices: sink.0, depth: layout.depth, bounds: bvh.bounds(), isa: Isa::best() }
+        WideBvh {
+            nodes: layout.nodes,
+            prim_indices: sink.0,
+            depth: layout.depth,
+            bounds: bvh.bounds(),
+            isa: Isa::best(),
+        }
     }
 
     /// The instruction set queries run with.
@@ -249,6 +255,63 @@ impl Accel for WideBvh {
                 + std::mem::size_of_val(self.prim_indices.as_slice()),
             sah_cost: None,
             leaf_sizes,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::Vec3;
+
+    use super::traverse::INLINE_DEPTH;
+    use super::*;
+    use crate::accel::bvh::{BuildKind, BuildNode, BuildTree};
+    use crate::accel::{AccelKind, AnyAccel, NoCount};
+    use crate::shapes::AaBox;
+
+    /// A chain: interior node `k` holds leaf `k` and node `k + 1`, so the wide tree is about
+    /// `n / 7` nodes deep, and queries use the per-thread stack instead of the inline one.
+    fn chain(n: u32) -> (Vec<Aabb>, Bvh) {
+        let boxes: Vec<Aabb> =
+            (0..n).map(|i| Aabb::new(Vec3::new(i as f32, 0.0, 0.0), Vec3::new(i as f32 + 0.5, 1.0, 1.0))).collect();
+        let mut nodes: Vec<BuildNode> = boxes
+            .iter()
+            .enumerate()
+            .map(|(i, &b)| BuildNode { bounds: b, kind: BuildKind::Leaf { first: i as u32, count: 1 } })
+            .collect();
+        for i in 0..n - 1 {
+            let bounds = Aabb::new(Vec3::new(i as f32, 0.0, 0.0), Vec3::new(n as f32, 1.0, 1.0));
+            let next = if i + 1 == n - 1 { n - 1 } else { n + i + 1 };
+            nodes.push(BuildNode { bounds, kind: BuildKind::Interior { children: [i, next] } });
+        }
+        let bvh = BuildTree { nodes, prims: (0..n).collect(), root: n }.into_bvh();
+        (boxes, bvh)
+    }
+
+    #[test]
+    fn trees_deeper_than_the_inline_stack_agree_with_brute_force() {
+        let (boxes, bvh) = chain(600);
+        let mut wide = WideBvh::from_bvh(&bvh);
+        wide.validate(&boxes).unwrap();
+        assert!(wide.depth() as usize > INLINE_DEPTH, "depth {}", wide.depth());
+        let shapes: Vec<AaBox> = boxes.iter().map(|b| AaBox::new(b.min, b.max)).collect();
+        let test = |i: u32, r: &Ray| crate::shapes::Intersect::intersect(&shapes[i as usize], r);
+        let brute = AnyAccel::build(AccelKind::None, &boxes);
+        let rays: Vec<Ray> = (0..50)
+            .flat_map(|k| {
+                let y = 0.1 + k as f32 * 0.015;
+                [Ray::new(Vec3::new(700.0, y, 0.5), -Vec3::X), Ray::new(Vec3::new(-1.0, y, 0.5), Vec3::X)]
+            })
+            .chain([Ray::segment(Vec3::new(300.25, 0.5, 0.5), Vec3::X, 0.0, 3.0)])
+            .collect();
+        for isa in Isa::available() {
+            wide.set_isa(isa).unwrap();
+            for r in &rays {
+                let expected = brute.closest_hit(r, &mut NoCount, test);
+                assert_eq!(wide.closest_hit(r, &mut NoCount, test), expected, "{isa}: {r:?}");
+                assert!(expected.is_some());
+                assert!(wide.any_hit(r, &mut NoCount, |i, r| test(i, r).is_some()), "{isa}: {r:?}");
+            }
         }
     }
 }

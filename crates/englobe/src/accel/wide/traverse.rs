@@ -110,7 +110,8 @@ pub unsafe fn closest<K: NodeKernel, C: Counters, L: Leaves<C>>(
                     }
                     let second = mask.trailing_zeros() as usize;
                     mask &= mask - 1;
-                    let b = Entry { reference: node.children[second], count: node.counts[second] as u32, t: dist[second] };
+                    let b =
+                        Entry { reference: node.children[second], count: node.counts[second] as u32, t: dist[second] };
                     if mask == 0 {
                         let (near, far) = if b.t < a.t { (b, a) } else { (a, b) };
                         stack[len].write(far);
@@ -127,7 +128,11 @@ pub unsafe fn closest<K: NodeKernel, C: Counters, L: Leaves<C>>(
                     while mask != 0 {
                         let i = mask.trailing_zeros() as usize;
                         mask &= mask - 1;
-                        stack[len].write(Entry { reference: node.children[i], count: node.counts[i] as u32, t: dist[i] });
+                        stack[len].write(Entry {
+                            reference: node.children[i],
+                            count: node.counts[i] as u32,
+                            t: dist[i],
+                        });
                         len += 1;
                     }
                     for i in base + 1..len {

@@ -189,7 +189,8 @@ impl TriangleBvh {
                 let c = node.children[slot];
                 if c != super::node::EMPTY && super::node::is_leaf(c) {
                     let first = super::node::index_of(c) as usize;
-                    let tris: u32 = self.blocks[first..first + node.counts[slot] as usize].iter().map(TriBlock::used).sum();
+                    let tris: u32 =
+                        self.blocks[first..first + node.counts[slot] as usize].iter().map(TriBlock::used).sum();
                     leaf_sizes[(tris as usize).clamp(1, LEAF_SIZE_BUCKETS) - 1] += 1;
                     leaves += 1;
                 }

@@ -292,7 +292,8 @@ mod tests {
         for i in 0..=8 {
             for j in 0..=8 {
                 let o = Vec3::new(i as f32 * 0.25, j as f32 * 0.25, 2.0);
-                for d in [-Vec3::Z, Vec3::new(0.0, -0.0, -1.0), Vec3::new(0.25, 0.25, -1.0), Vec3::new(-0.5, 0.0, -1.0)] {
+                for d in [-Vec3::Z, Vec3::new(0.0, -0.0, -1.0), Vec3::new(0.25, 0.25, -1.0), Vec3::new(-0.5, 0.0, -1.0)]
+                {
                     hits += agree(&tris, &Ray::new(o, d));
                 }
             }
