@@ -86,10 +86,7 @@ impl LibraryKind {
 
     /// Whether this build can run it (Embree needs the `embree` feature).
     pub fn available(self) -> bool {
-        match self {
-            LibraryKind::Embree | LibraryKind::EmbreePacket16 => cfg!(feature = "embree"),
-            _ => true,
-        }
+        cfg!(feature = "embree") || !matches!(self, LibraryKind::Embree | LibraryKind::EmbreePacket16)
     }
 
     /// The libraries this build can run, in table order.
