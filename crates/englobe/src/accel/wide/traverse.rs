@@ -55,20 +55,34 @@ thread_local! {
     static DEEP_STACK: Cell<Vec<MaybeUninit<Entry>>> = const { Cell::new(Vec::new()) };
 }
 
-/// Runs `query` with a stack of at least `(WIDTH - 1) * depth + 1` entries: each level of the
-/// path pushes at most seven, and the deepest briefly holds all eight of its children.
+/// A query's stack: `inline` if the tree is shallow enough, else the thread's deep stack, taken
+/// (left empty in its place) and grown to hold `(WIDTH - 1) * depth + 1` entries: each level of the
+/// path pushes at most seven, and the deepest briefly holds all eight of its children. Hand a
+/// taken stack back with [`give_back`].
+///
+/// Not a closure-taking helper on purpose: a closure's body is compiled without the caller's
+/// `#[target_feature]`s, and then every intrinsic in it becomes a call.
 #[inline(always)]
-pub fn with_stack<R>(depth: u32, query: impl FnOnce(&mut [MaybeUninit<Entry>]) -> R) -> R {
+fn stack_for<'a>(
+    depth: u32,
+    inline: &'a mut [MaybeUninit<Entry>; INLINE_ENTRIES],
+    deep: &'a mut Vec<MaybeUninit<Entry>>,
+) -> &'a mut [MaybeUninit<Entry>] {
     let needed = (WIDTH - 1) * depth as usize + 1;
     if needed <= INLINE_ENTRIES {
-        let mut inline = [const { MaybeUninit::<Entry>::uninit() }; INLINE_ENTRIES];
-        query(&mut inline)
+        inline
     } else {
-        let mut stack = DEEP_STACK.with(Cell::take);
-        stack.resize(needed.max(stack.len()), MaybeUninit::uninit());
-        let result = query(&mut stack);
-        DEEP_STACK.with(|kept| kept.set(stack));
-        result
+        *deep = DEEP_STACK.with(Cell::take);
+        deep.resize(needed.max(deep.len()), MaybeUninit::uninit());
+        deep
+    }
+}
+
+/// Returns a stack taken by [`stack_for`] to the thread, for the next deep query.
+#[inline(always)]
+fn give_back(deep: Vec<MaybeUninit<Entry>>) {
+    if deep.capacity() > 0 {
+        DEEP_STACK.with(|kept| kept.set(deep));
     }
 }
 
@@ -87,11 +101,14 @@ pub unsafe fn closest<K: NodeKernel, C: Counters, L: Leaves<C>>(
     leaves: &mut L,
     counters: &mut C,
 ) {
-    with_stack(depth, |stack| {
-        let mut len = 0usize;
-        let mut dist = [0.0f32; WIDTH];
-        let mut current = Entry { reference: 0, count: 0, t: 0.0 };
-        loop {
+    let mut inline = [const { MaybeUninit::<Entry>::uninit() }; INLINE_ENTRIES];
+    let mut deep = Vec::new();
+    let stack = stack_for(depth, &mut inline, &mut deep);
+    let mut len = 0usize;
+    let mut dist = [0.0f32; WIDTH];
+    let mut current = Entry { reference: 0, count: 0, t: 0.0 };
+    'walk: loop {
+        {
             if is_leaf(current.reference) {
                 leaves.closest(index_of(current.reference), current.count, counters);
             } else {
@@ -154,7 +171,7 @@ pub unsafe fn closest<K: NodeKernel, C: Counters, L: Leaves<C>>(
             // Next pending child the ray still enters before the closest hit.
             loop {
                 if len == 0 {
-                    return;
+                    break 'walk;
                 }
                 len -= 1;
                 // SAFETY: entries below `len` were written.
@@ -165,7 +182,8 @@ pub unsafe fn closest<K: NodeKernel, C: Counters, L: Leaves<C>>(
                 }
             }
         }
-    })
+    }
+    give_back(deep);
 }
 
 /// Whether any leaf item is hit: stops at the first one `leaves` reports.
@@ -182,14 +200,17 @@ pub unsafe fn any<K: NodeKernel, C: Counters, L: Leaves<C>>(
     leaves: &mut L,
     counters: &mut C,
 ) -> bool {
-    with_stack(depth, |stack| {
-        let mut len = 0usize;
-        let mut dist = [0.0f32; WIDTH];
-        let mut current = Entry { reference: 0, count: 0, t: 0.0 };
-        loop {
+    let mut inline = [const { MaybeUninit::<Entry>::uninit() }; INLINE_ENTRIES];
+    let mut deep = Vec::new();
+    let stack = stack_for(depth, &mut inline, &mut deep);
+    let mut len = 0usize;
+    let mut dist = [0.0f32; WIDTH];
+    let mut current = Entry { reference: 0, count: 0, t: 0.0 };
+    let hit = 'walk: loop {
+        {
             if is_leaf(current.reference) {
                 if leaves.any(index_of(current.reference), current.count, counters) {
-                    return true;
+                    break 'walk true;
                 }
             } else {
                 let node = &nodes[current.reference as usize];
@@ -211,11 +232,13 @@ pub unsafe fn any<K: NodeKernel, C: Counters, L: Leaves<C>>(
                 }
             }
             if len == 0 {
-                return false;
+                break 'walk false;
             }
             len -= 1;
             // SAFETY: entries below `len` were written.
             current = unsafe { stack[len].assume_init() };
         }
-    })
+    };
+    give_back(deep);
+    hit
 }
