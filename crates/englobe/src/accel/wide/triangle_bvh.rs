@@ -31,7 +31,7 @@ pub struct TriangleBvhOptions {
 
 impl Default for TriangleBvhOptions {
     fn default() -> Self {
-        TriangleBvhOptions { builder: BinnedSah::default(), collapse: LANES }
+        TriangleBvhOptions { builder: BinnedSah { small_leaf: LANES, ..BinnedSah::default() }, collapse: LANES }
     }
 }
 
