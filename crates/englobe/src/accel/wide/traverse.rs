@@ -6,8 +6,8 @@
 //! et al. 2014): no sorting at all when one child or two are hit (the common cases), a short
 //! insertion sort of the hit children otherwise.
 //!
-//! Occlusion queries stop at the first occluder and do not sort: distance order only pays when
-//! the query must find the nearest hit.
+//! Occlusion queries stop at the first occluder and do not sort: they enter the nearest child hit
+//! first (the likeliest to hold an occluder) and push the others as they come.
 //!
 //! The traversal is generic over the node test ([`NodeKernel`], one per instruction set) and over
 //! what leaves hold ([`Leaves`]: primitive references tested by a closure, or blocks of
@@ -219,15 +219,18 @@ pub unsafe fn any<K: NodeKernel, C: Counters, L: Leaves<C>>(
                 // SAFETY: the caller's guarantee.
                 let mut mask = unsafe { kernel.children(node, ray, limit, &mut dist) };
                 if mask != 0 {
-                    let first = mask.trailing_zeros() as usize;
+                    // The nearest child first (it is the likeliest to hold an occluder), the
+                    // others pushed as they come.
+                    let mut nearest = mask.trailing_zeros() as usize;
                     mask &= mask - 1;
                     while mask != 0 {
                         let i = mask.trailing_zeros() as usize;
                         mask &= mask - 1;
-                        stack[len].write(Entry { reference: node.children[i], count: node.counts[i] as u32, t: 0.0 });
+                        let push = if dist[i] < dist[nearest] { std::mem::replace(&mut nearest, i) } else { i };
+                        stack[len].write(Entry { reference: node.children[push], count: node.counts[push] as u32, t: 0.0 });
                         len += 1;
                     }
-                    current = Entry { reference: node.children[first], count: node.counts[first] as u32, t: 0.0 };
+                    current = Entry { reference: node.children[nearest], count: node.counts[nearest] as u32, t: 0.0 };
                     continue;
                 }
             }
