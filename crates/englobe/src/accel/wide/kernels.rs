@@ -77,8 +77,11 @@ mod x86 {
             for a in 0..3 {
                 let o = _mm256_set1_ps(ray.origin[a]);
                 let inv = _mm256_set1_ps(ray.inv_dir[a]);
-                let near = _mm256_load_ps(node.bounds[ray.near[a]].as_ptr());
-                let far = _mm256_load_ps(node.bounds[ray.far[a]].as_ptr());
+                // The rows from the direction's sign bit (as `NodeRay::near` and `far` hold
+                // them): indices the compiler sees are in bounds, so no check per row.
+                let down = (ray.negative_bits >> a & 1) as usize;
+                let near = _mm256_load_ps(node.bounds[2 * a + down].as_ptr());
+                let far = _mm256_load_ps(node.bounds[2 * a + 1 - down].as_ptr());
                 let t_near = _mm256_mul_ps(_mm256_sub_ps(near, o), inv);
                 let t_far = _mm256_mul_ps(_mm256_mul_ps(_mm256_sub_ps(far, o), inv), scale);
                 // `max(a, b)` is `a > b ? a : b`, `b` when either is NaN: the scalar rule.
