@@ -54,6 +54,22 @@ pub trait Leaves<C: Counters> {
     }
 }
 
+/// Asks for every child of `node` in `mask` (the ones a ray enters), so that their cache misses
+/// overlap instead of following one another as the walk reaches them.
+#[inline(always)]
+fn prefetch_children<C: Counters, L: Leaves<C>>(nodes: &[WideNode], node: &WideNode, mut mask: u32, leaves: &L) {
+    while mask != 0 {
+        let i = mask.trailing_zeros() as usize;
+        mask &= mask - 1;
+        let c = node.children[i];
+        if is_leaf(c) {
+            leaves.prefetch(index_of(c));
+        } else {
+            prefetch_node(nodes, c);
+        }
+    }
+}
+
 /// Starts loading the node `index` into the cache (all four of its lines).
 #[inline(always)]
 fn prefetch_node(nodes: &[WideNode], index: u32) {
@@ -140,19 +156,7 @@ pub unsafe fn closest<K: NodeKernel, C: Counters, L: Leaves<C>>(
                 counters.box_tests(WIDTH as u32);
                 // SAFETY: the caller's guarantee.
                 let mut mask = unsafe { kernel.children(node, ray, reach(leaves.t_max()), &mut dist) };
-                // Ask for every child entered now, so that their cache misses overlap instead of
-                // following one another as the walk reaches them.
-                let mut fetch = mask;
-                while fetch != 0 {
-                    let i = fetch.trailing_zeros() as usize;
-                    fetch &= fetch - 1;
-                    let c = node.children[i];
-                    if is_leaf(c) {
-                        leaves.prefetch(index_of(c));
-                    } else {
-                        prefetch_node(nodes, c);
-                    }
-                }
+                prefetch_children(nodes, node, mask, leaves);
                 if mask != 0 {
                     let first = mask.trailing_zeros() as usize;
                     mask &= mask - 1;
@@ -254,6 +258,7 @@ pub unsafe fn any<K: NodeKernel, C: Counters, L: Leaves<C>>(
                 counters.box_tests(WIDTH as u32);
                 // SAFETY: the caller's guarantee.
                 let mut mask = unsafe { kernel.children(node, ray, limit, &mut dist) };
+                prefetch_children(nodes, node, mask, leaves);
                 if mask != 0 {
                     // The nearest child first (it is the likeliest to hold an occluder), the
                     // others pushed as they come.
