@@ -36,7 +36,11 @@ fn the_grid_is_sensitive_to_differences_of_scale() {
     let stadium = tests_per_ray("teapot-stadium.toml", 64, 48, &kinds);
     assert!(stadium[1] >= 10.0 * stadium[0], "teapot in a stadium: grid {} vs {BVH} {}", stadium[1], stadium[0]);
     let uniform = tests_per_ray("uniform-triangles.toml", 64, 48, &kinds);
-    assert!(uniform[1] <= 2.0 * uniform[0], "uniform cube: grid {} vs {BVH} {}", uniform[1], uniform[0]);
+    // Against the SAH BVH (not the seed BVH the bound was first set against) the grid makes about
+    // 2.6 times its exact tests on the uniform cube: close, and far from the stadium's ratio.
+    assert!(uniform[1] <= 3.0 * uniform[0], "uniform cube: grid {} vs {BVH} {}", uniform[1], uniform[0]);
+    let (stadium_ratio, uniform_ratio) = (stadium[1] / stadium[0], uniform[1] / uniform[0]);
+    assert!(stadium_ratio >= 4.0 * uniform_ratio, "grid/{BVH}: stadium {stadium_ratio}, uniform {uniform_ratio}");
 }
 
 #[test]
