@@ -108,11 +108,11 @@ pub fn scene_info(path: &Path, scene: &Scene) -> String {
                 Some(i.mesh())
             }
         };
-        if let Some(m) = mesh {
-            if distinct.insert(std::sync::Arc::as_ptr(m)) {
-                stored_triangles += m.len();
-                stored_bytes += mesh_bytes(m);
-            }
+        if let Some(m) = mesh
+            && distinct.insert(std::sync::Arc::as_ptr(m))
+        {
+            stored_triangles += m.len();
+            stored_bytes += mesh_bytes(m);
         }
     }
     let _ = writeln!(out, "file:       {}", path.display());

@@ -1,5 +1,5 @@
-//! The `englobe` command: render scenes and measure how acceleration structures cut the work of
-//! ray tracing.
+//! The `englobe` command: render scenes, measure how acceleration structures cut the work of ray
+//! tracing, and benchmark englobe against other libraries (`bench`, forwarded to englobe-bench).
 
 mod compare_cmd;
 mod experiment_cmd;
@@ -34,6 +34,10 @@ enum Command {
     Experiment(experiment_cmd::ExperimentArgs),
     /// Build every accelerator for one scene and compare build time, memory, speed and work.
     Compare(compare_cmd::CompareArgs),
+    /// Measure englobe against Intel Embree, obvhs and bvh on the same rays (Embree with the
+    /// `embree` cargo feature); prints a table per scene and thread count, writes a CSV and prints
+    /// its path last.
+    Bench(englobe_bench::BenchArgs),
     /// Say what a mesh file (.obj, .ply, .gltf, .glb) or a scene file (.toml) holds, or why it is
     /// refused.
     Info(info_cmd::InfoArgs),
@@ -46,6 +50,7 @@ fn main() -> ExitCode {
         Command::Experiment(args) => experiment_cmd::run(args),
         Command::Compare(args) => compare_cmd::run(args),
         Command::Info(args) => info_cmd::run(args),
+        Command::Bench(args) => englobe_bench::run(&args),
     };
     match result {
         Ok(code) => code,

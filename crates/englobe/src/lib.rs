@@ -24,7 +24,7 @@ pub mod shapes;
 pub mod world;
 
 pub use aabb::Aabb;
-pub use accel::{Accel, AccelKind, AnyAccel, Counters, Hit, NoCount, WorkCounts};
+pub use accel::{Accel, AccelKind, AnyAccel, Counters, Hit, NoCount, TriangleBvh, WideBvh, WorkCounts};
 pub use glam::{Affine3A, Mat4, Vec2, Vec3};
 pub use ray::Ray;
 pub use shapes::{AaBox, Bounded, Instance, Intersect, Plane, PrimHit, Shape, Sphere, Triangle, TriangleMesh};

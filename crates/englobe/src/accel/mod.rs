@@ -10,6 +10,8 @@
 //! * [`kdtree`]: the SAH kd-tree, built in O(N log N) with split clipping.
 //! * [`grid`]: the uniform grid, traversed with a 3D-DDA.
 //! * [`mailbox`]: what spares the spatial subdivisions a second test of the same primitive.
+//! * [`wide`]: the eight-wide BVH traversed with SIMD, and [`TriangleBvh`], its fast path for
+//!   triangle meshes.
 //! * [`validate`]: the invariants of a BVH, checked, and its quality, measured.
 
 pub mod bound;
@@ -20,6 +22,7 @@ pub mod grid;
 pub mod kdtree;
 pub mod mailbox;
 pub mod validate;
+pub mod wide;
 
 use std::fmt;
 use std::str::FromStr;
@@ -30,6 +33,7 @@ pub use bvh::{BinnedSah, Bvh, CandidateListBvh, Ploc, SeedPairing, SweepSah};
 pub use counters::{Counters, NoCount, WorkCounts};
 pub use grid::{Grid, GridParams};
 pub use kdtree::{ClipFn, KdTree, KdTreeParams};
+pub use wide::{Isa, TriangleBvh, WideBvh};
 
 use crate::shapes::PrimHit;
 use crate::{Aabb, Ray};
@@ -157,6 +161,8 @@ pub enum AccelKind {
     KdTree,
     /// The uniform grid ([`Grid`]).
     Grid,
+    /// The binned SAH tree made eight-wide and traversed with SIMD ([`WideBvh`]).
+    BvhWide,
 }
 
 impl AccelKind {
@@ -170,6 +176,7 @@ impl AccelKind {
         AccelKind::BvhSweep,
         AccelKind::KdTree,
         AccelKind::Grid,
+        AccelKind::BvhWide,
     ];
 
     /// Yardsticks that answer like brute force and count what the structures are measured
@@ -188,6 +195,7 @@ impl AccelKind {
             AccelKind::Bound => "bound",
             AccelKind::KdTree => "kdtree",
             AccelKind::Grid => "grid",
+            AccelKind::BvhWide => "bvh-wide",
         }
     }
 
@@ -215,6 +223,9 @@ impl AccelKind {
                 "SAH kd-tree built in O(N log N) with split clipping, traversed front to back with mailboxing"
             }
             AccelKind::Grid => "uniform grid of about 27 cells per primitive, traversed with the 3D-DDA and mailboxing",
+            AccelKind::BvhWide => {
+                "the binned-SAH BVH made eight-wide, all children's boxes tested at once with SIMD (AVX2, AVX-512 or portable)"
+            }
         }
     }
 }
@@ -267,6 +278,8 @@ pub enum AnyAccel {
     KdTree(KdTree),
     /// See [`AccelKind::Grid`].
     Grid(Grid),
+    /// See [`AccelKind::BvhWide`].
+    BvhWide(WideBvh),
 }
 
 impl AnyAccel {
@@ -290,13 +303,14 @@ impl AnyAccel {
             AccelKind::BvhPloc => AnyAccel::BvhPloc(Ploc::default().build(boxes)),
             AccelKind::BvhSweep => AnyAccel::BvhSweep(SweepSah::default().build(boxes)),
             AccelKind::Bound => AnyAccel::Bound(LowerBound::build(boxes)),
+            AccelKind::BvhWide => AnyAccel::BvhWide(WideBvh::build(boxes)),
         }
     }
 
     /// The BVH behind the structure, if it is one (for validation and statistics).
     pub fn bvh(&self) -> Option<&Bvh> {
         match self {
-            AnyAccel::BruteForce(_) | AnyAccel::Bound(_) => None,
+            AnyAccel::BruteForce(_) | AnyAccel::Bound(_) | AnyAccel::BvhWide(_) => None,
             AnyAccel::BvhSeed(a) => Some(a.bvh()),
             AnyAccel::BvhSeedOrdered(a) | AnyAccel::BvhSah(a) | AnyAccel::BvhPloc(a) | AnyAccel::BvhSweep(a) => Some(a),
             AnyAccel::KdTree(_) | AnyAccel::Grid(_) => None,
@@ -326,6 +340,7 @@ macro_rules! dispatch_accel {
             AnyAccel::Bound($a) => $e,
             AnyAccel::KdTree($a) => $e,
             AnyAccel::Grid($a) => $e,
+            AnyAccel::BvhWide($a) => $e,
         }
     };
 }

@@ -75,6 +75,18 @@ impl WatertightRay {
         let shear = Vec3::new(d[kx] / d[kz], d[ky] / d[kz], 1.0 / d[kz]);
         WatertightRay { kx, ky, kz, shear }
     }
+
+    /// The axes `[kx, ky, kz]`: the ray runs along `kz` in the sheared frame.
+    #[inline(always)]
+    pub fn axes(&self) -> [usize; 3] {
+        [self.kx, self.ky, self.kz]
+    }
+
+    /// The shear `(d[kx] / d[kz], d[ky] / d[kz], 1 / d[kz])`.
+    #[inline(always)]
+    pub fn shear(&self) -> Vec3 {
+        self.shear
+    }
 }
 
 /// The watertight test of `ray` against the triangle `v0 v1 v2`, with the ray's constants `w`.

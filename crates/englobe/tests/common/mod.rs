@@ -10,7 +10,7 @@ use englobe::accel::ClipFn;
 use englobe::accel::grid::stats::validate_grid_clipped;
 use englobe::accel::kdtree::stats::validate_kdtree;
 use englobe::accel::validate::validate_bvh;
-use englobe::{Aabb, Accel, AccelKind, AnyAccel, Hit, NoCount, PrimHit, Ray, WorkCounts};
+use englobe::{Aabb, Accel, AccelKind, AnyAccel, Hit, NoCount, PrimHit, Ray, TriangleMesh, Vec3, WorkCounts};
 
 /// Relative tolerance on the closest hit's `t`.
 pub const T_TOLERANCE: f32 = 1e-6;
@@ -109,17 +109,16 @@ pub fn shared_dir() -> PathBuf {
     })
 }
 
-/// A mesh of the shared data folder (`relative` to it), read with tobj and triangulated, its
-/// groups merged into one mesh.
-pub fn load_obj(relative: &str) -> englobe::TriangleMesh {
+/// A mesh of the shared data folder (path relative to it), all its objects in one mesh.
+pub fn load_obj(relative: &str) -> TriangleMesh {
     let path = shared_dir().join(relative);
     let (models, _) = tobj::load_obj(&path, &tobj::GPU_LOAD_OPTIONS)
         .unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()));
     let (mut positions, mut triangles) = (Vec::new(), Vec::new());
     for m in models {
         let base = positions.len() as u32;
-        positions.extend(m.mesh.positions.chunks_exact(3).map(|p| englobe::Vec3::new(p[0], p[1], p[2])));
+        positions.extend(m.mesh.positions.chunks_exact(3).map(|p| Vec3::new(p[0], p[1], p[2])));
         triangles.extend(m.mesh.indices.chunks_exact(3).map(|t| [base + t[0], base + t[1], base + t[2]]));
     }
-    englobe::TriangleMesh::new(positions, triangles).expect("a valid mesh")
+    TriangleMesh::new(positions, triangles).expect("a valid mesh")
 }

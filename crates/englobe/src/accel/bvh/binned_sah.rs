@@ -13,6 +13,8 @@
 //! `C_i * N`. When the centroids coincide, no plane separates them and the shared top-down driver
 //! ([`super::top_down`]) splits by count. Large subtrees are built in parallel.
 
+use glam::Vec3A;
+
 use super::top_down::{self, PrimRef, Splitter, partition, split_beats_leaf};
 use super::{BuildTree, Bvh};
 use crate::Aabb;
@@ -30,11 +32,15 @@ pub struct BinnedSah {
     pub bins: usize,
     /// Most primitives per leaf (at least 1).
     pub max_leaf: usize,
+    /// Nodes over at most this many primitives become leaves without a split search (0 by
+    /// default: every node is searched). For leaves whose primitives are tested several at once,
+    /// as the triangle blocks of [`crate::TriangleBvh`] are, where splitting them gains nothing.
+    pub small_leaf: usize,
 }
 
 impl Default for BinnedSah {
     fn default() -> Self {
-        BinnedSah { bins: MAX_BINS, max_leaf: DEFAULT_MAX_LEAF }
+        BinnedSah { bins: MAX_BINS, max_leaf: DEFAULT_MAX_LEAF, small_leaf: 0 }
     }
 }
 
@@ -50,14 +56,40 @@ impl BinnedSah {
     }
 }
 
-/// One slab of one axis: the boxes of the primitives whose centroids fall in it.
+/// One slab of one axis: the box of the primitives whose centroids fall in it (as SIMD vectors:
+/// the sweep is the builder's hot loop), and their number.
 #[derive(Clone, Copy, Debug)]
 struct Bin {
-    bounds: Aabb,
+    min: Vec3A,
+    max: Vec3A,
     count: u32,
 }
 
-const EMPTY_BIN: Bin = Bin { bounds: Aabb::EMPTY, count: 0 };
+const EMPTY_BIN: Bin = Bin { min: Vec3A::INFINITY, max: Vec3A::NEG_INFINITY, count: 0 };
+
+impl Bin {
+    #[inline(always)]
+    fn add(&mut self, b: &Aabb) {
+        self.min = self.min.min(Vec3A::from(b.min));
+        self.max = self.max.max(Vec3A::from(b.max));
+        self.count += 1;
+    }
+
+    #[inline(always)]
+    fn merge(&mut self, other: &Bin) {
+        self.min = self.min.min(other.min);
+        self.max = self.max.max(other.max);
+        self.count += other.count;
+    }
+
+    /// Surface area times count ([`Aabb::surface_area`]'s formula; only called on bins holding
+    /// primitives, whose boxes are not empty).
+    #[inline(always)]
+    fn weighted_area(&self) -> f32 {
+        let e = self.max - self.min;
+        2.0 * (e.x * e.y + e.y * e.z + e.z * e.x) * self.count as f32
+    }
+}
 
 /// The bin of coordinate `c` among `bins` bins starting at `min`, `scale` bins per unit. The same
 /// function places primitives and partitions them, so the two always agree; a NaN or an out of
@@ -82,7 +114,12 @@ impl Splitter for BinnedSah {
         must_split: bool,
         _: &mut (),
     ) -> Option<usize> {
-        let k = self.bins.clamp(2, MAX_BINS);
+        // A node over few primitives gets about as many bins as it has primitives (at least
+        // eight): more would mostly sweep empty bins, and the sweep is the cost of small nodes.
+        if !must_split && refs.len() <= self.small_leaf {
+            return None;
+        }
+        let k = self.bins.clamp(2, MAX_BINS).min(refs.len().max(8));
         let extent = centroid_bounds.extent();
         // Axes along which the centroids spread; the others cannot be split by a plane.
         let scale = extent.to_array().map(|e| if e > 0.0 { k as f32 / e } else { 0.0 });
@@ -94,9 +131,7 @@ impl Splitter for BinnedSah {
         for r in refs.iter() {
             for axis in 0..3 {
                 if scale[axis] > 0.0 {
-                    let bin = &mut bins[axis][bin_of(r.centroid[axis], min[axis], scale[axis], k)];
-                    bin.bounds = bin.bounds.union(&r.bounds);
-                    bin.count += 1;
+                    bins[axis][bin_of(r.centroid[axis], min[axis], scale[axis], k)].add(&r.bounds);
                 }
             }
         }
@@ -107,20 +142,18 @@ impl Splitter for BinnedSah {
             let bins = &bins[axis][..k];
             // right[i]: area times count of bins i.. (for the planes before bin i, i in 1..k).
             let mut right = [0.0f32; MAX_BINS];
-            let (mut right_box, mut right_count) = (Aabb::EMPTY, 0u32);
+            let mut side = EMPTY_BIN;
             for i in (1..k).rev() {
-                right_box = right_box.union(&bins[i].bounds);
-                right_count += bins[i].count;
-                right[i] = if right_count == 0 { f32::NAN } else { right_box.surface_area() * right_count as f32 };
+                side.merge(&bins[i]);
+                right[i] = if side.count == 0 { f32::NAN } else { side.weighted_area() };
             }
-            let (mut left_box, mut left_count) = (Aabb::EMPTY, 0u32);
+            let mut side = EMPTY_BIN;
             for i in 1..k {
-                left_box = left_box.union(&bins[i - 1].bounds);
-                left_count += bins[i - 1].count;
-                if left_count == 0 || right[i].is_nan() {
+                side.merge(&bins[i - 1]);
+                if side.count == 0 || right[i].is_nan() {
                     continue;
                 }
-                let cost = left_box.surface_area() * left_count as f32 + right[i];
+                let cost = side.weighted_area() + right[i];
                 if best.is_none_or(|(c, _, _)| cost < c) {
                     best = Some((cost, axis, i));
                 }
@@ -176,7 +209,7 @@ mod tests {
         let q = validate_bvh(&BinnedSah::default().build(&boxes), &boxes).unwrap();
         assert_eq!((q.leaves, q.max_leaf), (1, 8));
         // More than a leaf may hold: split anyway, into leaves no larger than allowed.
-        let builder = BinnedSah { bins: 8, max_leaf: 3 };
+        let builder = BinnedSah { bins: 8, max_leaf: 3, small_leaf: 0 };
         let q = validate_bvh(&builder.build(&boxes), &boxes).unwrap();
         assert!(q.max_leaf <= 3 && q.leaves >= 3, "{q:?}");
     }
@@ -192,7 +225,7 @@ mod tests {
     fn bins_out_of_range_are_clamped() {
         let boxes: Vec<Aabb> = (0..100).map(|i| cube(Vec3::new(i as f32, 0.0, 0.0), 0.4)).collect();
         for bins in [0, 1, 2, 1000] {
-            validate_bvh(&BinnedSah { bins, max_leaf: 4 }.build(&boxes), &boxes).unwrap();
+            validate_bvh(&BinnedSah { bins, max_leaf: 4, small_leaf: 0 }.build(&boxes), &boxes).unwrap();
         }
         assert_eq!(bin_of(f32::NAN, 0.0, 1.0, 8), 0);
         assert_eq!(bin_of(f32::INFINITY, 0.0, 1.0, 8), 7);

@@ -103,7 +103,7 @@ mod tests {
         // Identical boxes: leaves of 8, split by count: 30 = 7 + 8 + 7 + 8.
         let bvh = crate::accel::bvh::BinnedSah::default().build(&boxes);
         assert_eq!(bvh.leaf_sizes(), [0, 0, 0, 0, 0, 0, 2, 2, 0]);
-        let one = crate::accel::bvh::BinnedSah { bins: 8, max_leaf: 30 }.build(&boxes);
+        let one = crate::accel::bvh::BinnedSah { bins: 8, max_leaf: 30, small_leaf: 0 }.build(&boxes);
         assert_eq!(one.leaf_sizes(), [0, 0, 0, 0, 0, 0, 0, 0, 1]);
     }
 

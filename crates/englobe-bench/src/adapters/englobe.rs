@@ -1,0 +1,178 @@
+//! englobe under test. The structure is chosen by name (`--englobe-accel`): the triangle fast
+//! path [`TriangleBvh`] (`triangle-bvh`, the default; `triangle-bvh-avx2` and so on to pin an
+//! instruction set), or any [`AccelKind`] queried through [`World`]. To add another: give
+//! [`EnglobeStructure`] a variant, parse its name in [`EnglobeStructure::parse`], and build and
+//! query it in [`EnglobeLibrary`]; the harness, the agreement checks and the tables need nothing
+//! else.
+//!
+//! Queries run with the zero-sized [`NoCount`], so counting compiles away, and allocate nothing:
+//! the traversal's stack lives on the call stack.
+
+use std::fmt;
+
+use englobe::accel::wide::Isa;
+use englobe::{AccelKind, NoCount, Object, TriangleBvh, World};
+
+use crate::library::{Library, RayResult};
+use crate::rays::BenchRay;
+use crate::scene::BenchScene;
+
+/// The structures englobe can be measured with, best first: the default is the first one this
+/// build of englobe knows.
+pub const PREFERRED: &[&str] = &["triangle-bvh", "bvh-sah", "bvh-seed-ordered"];
+
+/// The name of the triangle fast path.
+const TRIANGLE_BVH: &str = "triangle-bvh";
+
+/// Which englobe structure to measure.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum EnglobeStructure {
+    /// A structure of [`AccelKind`], queried through [`World`] with a mesh object.
+    World(AccelKind),
+    /// The wide BVH over blocks of triangles, with the processor's best instruction set or the
+    /// one given.
+    Triangles(Option<Isa>),
+}
+
+impl EnglobeStructure {
+    /// The best structure available: the first of [`PREFERRED`] that parses.
+    pub fn best() -> Self {
+        PREFERRED
+            .iter()
+            .find_map(|name| Self::parse(name).ok())
+            .unwrap_or(EnglobeStructure::World(AccelKind::BvhSeedOrdered))
+    }
+
+    /// The structure called `name`.
+    pub fn parse(name: &str) -> Result<Self, String> {
+        if name == TRIANGLE_BVH {
+            return Ok(EnglobeStructure::Triangles(None));
+        }
+        if let Some(isa) = name.strip_prefix(TRIANGLE_BVH).and_then(|rest| rest.strip_prefix('-')) {
+            let isa = Isa::ALL.into_iter().find(|i| i.name() == isa).ok_or_else(|| {
+                let names: Vec<_> = Isa::ALL.iter().map(|i| format!("{TRIANGLE_BVH}-{i}")).collect();
+                format!("unknown instruction set in `{name}`; expected one of: {}", names.join(", "))
+            })?;
+            if !isa.is_available() {
+                return Err(format!("`{name}`: this processor cannot run the {isa} kernels"));
+            }
+            return Ok(EnglobeStructure::Triangles(Some(isa)));
+        }
+        name.parse::<AccelKind>()
+            .map(EnglobeStructure::World)
+            .map_err(|e| format!("{e}, or {TRIANGLE_BVH} (optionally -portable, -avx2 or -avx512)"))
+    }
+
+    /// Its name, as `--englobe-accel` takes it.
+    pub fn name(&self) -> String {
+        match self {
+            EnglobeStructure::World(kind) => kind.name().to_owned(),
+            EnglobeStructure::Triangles(None) => TRIANGLE_BVH.to_owned(),
+            EnglobeStructure::Triangles(Some(isa)) => format!("{TRIANGLE_BVH}-{isa}"),
+        }
+    }
+}
+
+impl Default for EnglobeStructure {
+    /// The best structure available ([`EnglobeStructure::best`]).
+    fn default() -> Self {
+        Self::best()
+    }
+}
+
+impl fmt::Display for EnglobeStructure {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.name())
+    }
+}
+
+/// englobe, built.
+pub struct EnglobeLibrary {
+    structure: EnglobeStructure,
+    built: Built,
+}
+
+/// The structure itself.
+enum Built {
+    World(World),
+    Triangles(TriangleBvh),
+}
+
+impl EnglobeLibrary {
+    /// Builds `structure` over the scene's mesh.
+    pub fn build(scene: &BenchScene, structure: EnglobeStructure) -> anyhow::Result<Self> {
+        match structure {
+            EnglobeStructure::World(kind) => {
+                let world = World::build(vec![Object::Mesh(scene.mesh.clone())], kind)?;
+                Ok(EnglobeLibrary { structure, built: Built::World(world) })
+            }
+            EnglobeStructure::Triangles(isa) => {
+                let mut bvh = TriangleBvh::build(&scene.mesh);
+                if let Some(isa) = isa {
+                    bvh.set_isa(isa)?;
+                }
+                Ok(EnglobeLibrary { structure, built: Built::Triangles(bvh) })
+            }
+        }
+    }
+}
+
+impl Library for EnglobeLibrary {
+    fn structure(&self) -> String {
+        match (&self.structure, &self.built) {
+            (EnglobeStructure::World(kind), _) => format!("{} through World", kind.name()),
+            (_, Built::Triangles(bvh)) => format!("{TRIANGLE_BVH} ({})", bvh.isa()),
+            (_, Built::World(_)) => self.structure.name(),
+        }
+    }
+
+    fn closest_hits(&self, rays: &[BenchRay], out: &mut [RayResult]) {
+        match &self.built {
+            Built::World(world) => {
+                for (ray, out) in rays.iter().zip(out) {
+                    let hit = world.closest_hit(&ray.to_englobe(), &mut NoCount);
+                    *out = hit.map_or(RayResult::MISS, |h| RayResult::hit(h.t, h.prim));
+                }
+            }
+            Built::Triangles(bvh) => {
+                for (ray, out) in rays.iter().zip(out) {
+                    let hit = bvh.closest_hit(&ray.to_englobe(), &mut NoCount);
+                    *out = hit.map_or(RayResult::MISS, |h| RayResult::hit(h.t, h.prim));
+                }
+            }
+        }
+    }
+
+    fn any_hits(&self, rays: &[BenchRay], out: &mut [bool]) {
+        match &self.built {
+            Built::World(world) => {
+                for (ray, out) in rays.iter().zip(out) {
+                    *out = world.any_hit(&ray.to_englobe(), &mut NoCount);
+                }
+            }
+            Built::Triangles(bvh) => {
+                for (ray, out) in rays.iter().zip(out) {
+                    *out = bvh.any_hit(&ray.to_englobe(), &mut NoCount);
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_best_structure_is_known_and_names_round_trip() {
+        let best = EnglobeStructure::best();
+        assert_eq!(EnglobeStructure::parse(&best.name()).unwrap(), best);
+        assert_eq!(best, EnglobeStructure::Triangles(None));
+        assert!(EnglobeStructure::parse("octree").is_err());
+        assert!(EnglobeStructure::parse("triangle-bvh-sse9").is_err());
+        for isa in Isa::available() {
+            let s = EnglobeStructure::parse(&format!("triangle-bvh-{isa}")).unwrap();
+            assert_eq!((s, EnglobeStructure::parse(&s.name()).unwrap()), (EnglobeStructure::Triangles(Some(isa)), s));
+        }
+    }
+}

@@ -1,0 +1,152 @@
+//! Timing: a query set traced by one library on a pool of `n` threads, the rays split into chunks
+//! that the threads take in turn; one untimed warm-up run, then `reps` timed runs, and their
+//! median. Results are written into buffers allocated once, outside the timed runs.
+
+use std::time::Instant;
+
+use rayon::prelude::*;
+
+use crate::library::{Library, RayResult};
+use crate::rays::BenchRay;
+
+/// Rays per task handed to a thread (a multiple of every packet width).
+pub const CHUNK: usize = 1024;
+
+/// The two queries.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Query {
+    /// Closest hit.
+    Closest,
+    /// Any hit (occlusion).
+    Any,
+}
+
+impl Query {
+    /// Name in tables and the CSV.
+    pub fn name(self) -> &'static str {
+        match self {
+            Query::Closest => "closest",
+            Query::Any => "any",
+        }
+    }
+}
+
+/// Where a query's answers go.
+pub enum Answers {
+    /// Closest hits.
+    Closest(Vec<RayResult>),
+    /// Any-hit answers.
+    Any(Vec<bool>),
+}
+
+impl Answers {
+    /// A buffer for `n` answers to `query`.
+    pub fn new(query: Query, n: usize) -> Self {
+        match query {
+            Query::Closest => Answers::Closest(vec![RayResult::MISS; n]),
+            Query::Any => Answers::Any(vec![false; n]),
+        }
+    }
+}
+
+/// A pool of exactly `threads` worker threads.
+pub fn thread_pool(threads: usize) -> anyhow::Result<rayon::ThreadPool> {
+    Ok(rayon::ThreadPoolBuilder::new().num_threads(threads).build()?)
+}
+
+/// Traces every ray once, on the current rayon pool.
+pub fn trace(library: &dyn Library, rays: &[BenchRay], answers: &mut Answers) {
+    match answers {
+        Answers::Closest(out) => rays
+            .par_chunks(CHUNK)
+            .zip(out.par_chunks_mut(CHUNK))
+            .for_each(|(rays, out)| library.closest_hits(rays, out)),
+        Answers::Any(out) => {
+            rays.par_chunks(CHUNK).zip(out.par_chunks_mut(CHUNK)).for_each(|(rays, out)| library.any_hits(rays, out))
+        }
+    }
+}
+
+/// Seconds of each timed run.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Timing {
+    /// Every run, in order.
+    pub runs: Vec<f64>,
+}
+
+impl Timing {
+    /// The median run.
+    pub fn median(&self) -> f64 {
+        median(&self.runs)
+    }
+}
+
+/// The median of `values` (the mean of the two middle ones for an even count); NaN if empty.
+pub fn median(values: &[f64]) -> f64 {
+    if values.is_empty() {
+        return f64::NAN;
+    }
+    let mut v = values.to_vec();
+    v.sort_by(f64::total_cmp);
+    let mid = v.len() / 2;
+    if v.len() % 2 == 1 { v[mid] } else { 0.5 * (v[mid - 1] + v[mid]) }
+}
+
+/// Warm-up then `reps` timed runs of `query` over `rays` on `pool`; the answers of the last run
+/// are left in `answers`.
+pub fn time_query(
+    pool: &rayon::ThreadPool,
+    library: &dyn Library,
+    rays: &[BenchRay],
+    answers: &mut Answers,
+    reps: usize,
+) -> Timing {
+    pool.install(|| {
+        trace(library, rays, answers);
+        let runs = (0..reps)
+            .map(|_| {
+                let start = Instant::now();
+                trace(library, rays, answers);
+                start.elapsed().as_secs_f64()
+            })
+            .collect();
+        Timing { runs }
+    })
+}
+
+/// Runs `build` once untimed (a warm-up: thread pools started, pages mapped), then `reps` times
+/// timed, on `pool`; returns the last result with the median time in milliseconds. Each build but
+/// the last is dropped before the next starts.
+pub fn time_build<T>(
+    pool: &rayon::ThreadPool,
+    reps: usize,
+    mut build: impl FnMut() -> anyhow::Result<T> + Send,
+) -> anyhow::Result<(T, f64)>
+where
+    T: Send,
+{
+    pool.install(|| {
+        let mut times = Vec::with_capacity(reps.max(1));
+        let mut last = Some(build()?);
+        for _ in 0..reps.max(1) {
+            drop(last.take());
+            let start = Instant::now();
+            let built = build()?;
+            times.push(start.elapsed().as_secs_f64() * 1e3);
+            last = Some(built);
+        }
+        Ok((last.expect("at least one build"), median(&times)))
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn medians() {
+        assert_eq!(median(&[3.0, 1.0, 2.0]), 2.0);
+        assert_eq!(median(&[4.0, 1.0, 2.0, 3.0]), 2.5);
+        assert!(median(&[]).is_nan());
+    }
+}

@@ -1,0 +1,72 @@
+//! The triangle fast path on mesh files: build time (median of five builds, in triangles per
+//! second), wide nodes, leaves, triangles per leaf and per block, bytes, and the work of random
+//! rays (wide nodes visited and triangles tested per ray). Where `docs/performance.md`'s structure
+//! figures come from:
+//!
+//! ```sh
+//! cargo run --release -p englobe-cli --example triangle_bvh_stats -- \
+//!     ../shared/scenes/meshes/bunny/stanford-bunny.obj ../shared/scenes/meshes/ogre/ogre.obj
+//! ```
+
+use std::path::Path;
+use std::time::Instant;
+
+use anyhow::Context;
+use englobe::{Ray, TriangleBvh, Vec3, WorkCounts};
+use englobe_scene::mesh::load_mesh_file;
+
+fn main() -> anyhow::Result<()> {
+    for path in std::env::args().skip(1) {
+        let loaded = load_mesh_file(Path::new(&path)).with_context(|| path.clone())?;
+        let mesh = loaded.mesh;
+        let mut times = Vec::new();
+        let mut bvh = None;
+        for _ in 0..5 {
+            let start = Instant::now();
+            bvh = Some(TriangleBvh::build(&mesh));
+            times.push(start.elapsed().as_secs_f64());
+        }
+        times.sort_by(f64::total_cmp);
+        let bvh = bvh.expect("built");
+        let s = bvh.stats();
+        let blocks = bvh.blocks().len();
+        let stored = s.prim_refs;
+        println!(
+            "{path}: {} triangles; build {:.1} ms ({:.1} M triangles/s); {} wide nodes, {} leaves, depth {}; \
+             {:.2} triangles per leaf, {:.2} per block ({blocks} blocks); {:.1} MiB",
+            mesh.len(),
+            times[2] * 1e3,
+            mesh.len() as f64 / times[2] / 1e6,
+            s.nodes,
+            s.leaves,
+            s.depth,
+            stored as f64 / s.leaves as f64,
+            stored as f64 / blocks as f64,
+            s.memory_bytes as f64 / (1 << 20) as f64
+        );
+        // Random rays: uniform origins in the box, uniform directions (the harness's random set).
+        let (lo, extent) = (mesh.bounds().min, mesh.bounds().extent());
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 40) as f32 / (1u64 << 24) as f32
+        };
+        let mut c = WorkCounts::default();
+        let n = 100_000;
+        let mut hits = 0;
+        for _ in 0..n {
+            let o = lo + extent * Vec3::new(next(), next(), next());
+            let d = Vec3::new(next() - 0.5, next() - 0.5, next() - 0.5);
+            hits += bvh.closest_hit(&Ray::new(o, d), &mut c).is_some() as u32;
+        }
+        println!(
+            "  random rays, closest hit: {:.1} wide nodes and {:.1} triangles tested per ray ({:.1} % hit)",
+            c.nodes_visited as f64 / n as f64,
+            c.exact_tests as f64 / n as f64,
+            100.0 * hits as f64 / n as f64
+        );
+    }
+    Ok(())
+}

@@ -1,0 +1,129 @@
+//! The one place where a query picks its compiled kernels: a `match` on the structure's
+//! instruction set, each arm a copy of the traversal compiled with that set's target features
+//! (`#[target_feature]`, so one binary carries them all and runs on any x86-64).
+//!
+//! Soundness: the AVX2 and AVX-512 copies may only run on processors that have those features.
+//! A structure's [`Isa`] is chosen by [`Isa::best`] or changed only through a setter that checks
+//! [`Isa::is_available`], so an arm is only ever taken on a processor that can run it.
+
+use super::isa::Isa;
+use super::kernels::Portable;
+use super::node::{NodeRay, WideNode};
+use super::traverse::{self, Leaves};
+use crate::accel::Counters;
+
+/// The closest-hit traversal compiled for `isa`, which the processor must have (see the module
+/// documentation).
+#[inline(always)]
+pub fn closest<C: Counters, L: Leaves<C>>(
+    isa: Isa,
+    nodes: &[WideNode],
+    depth: u32,
+    ray: &NodeRay,
+    leaves: &mut L,
+    counters: &mut C,
+) {
+    debug_assert!(isa.is_available());
+    match isa {
+        // SAFETY: the portable kernel needs nothing beyond the target's baseline.
+        Isa::Portable => unsafe { traverse::closest(Portable, nodes, depth, ray, leaves, counters) },
+        // SAFETY: the structure's instruction set is one the processor has (module documentation).
+        #[cfg(target_arch = "x86_64")]
+        Isa::Avx2 => unsafe { x86::closest_avx2(nodes, depth, ray, leaves, counters) },
+        // SAFETY: as above.
+        #[cfg(target_arch = "x86_64")]
+        Isa::Avx512 => unsafe { x86::closest_avx512(nodes, depth, ray, leaves, counters) },
+        #[cfg(not(target_arch = "x86_64"))]
+        _ => unreachable!("x86 instruction sets are never available elsewhere"),
+    }
+}
+
+/// The any-hit traversal compiled for `isa` (see [`closest`]).
+#[inline(always)]
+pub fn any<C: Counters, L: Leaves<C>>(
+    isa: Isa,
+    nodes: &[WideNode],
+    depth: u32,
+    ray: &NodeRay,
+    limit: f32,
+    leaves: &mut L,
+    counters: &mut C,
+) -> bool {
+    debug_assert!(isa.is_available());
+    match isa {
+        // SAFETY: the portable kernel needs nothing beyond the target's baseline.
+        Isa::Portable => unsafe { traverse::any(Portable, nodes, depth, ray, limit, leaves, counters) },
+        // SAFETY: the structure's instruction set is one the processor has (module documentation).
+        #[cfg(target_arch = "x86_64")]
+        Isa::Avx2 => unsafe { x86::any_avx2(nodes, depth, ray, limit, leaves, counters) },
+        // SAFETY: as above.
+        #[cfg(target_arch = "x86_64")]
+        Isa::Avx512 => unsafe { x86::any_avx512(nodes, depth, ray, limit, leaves, counters) },
+        #[cfg(not(target_arch = "x86_64"))]
+        _ => unreachable!("x86 instruction sets are never available elsewhere"),
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+mod x86 {
+    use super::super::kernels::{Avx2, Avx512};
+    use super::*;
+
+    /// # Safety
+    /// The processor has AVX2 and FMA.
+    #[target_feature(enable = "avx2,fma")]
+    pub unsafe fn closest_avx2<C: Counters, L: Leaves<C>>(
+        nodes: &[WideNode],
+        depth: u32,
+        ray: &NodeRay,
+        leaves: &mut L,
+        counters: &mut C,
+    ) {
+        // SAFETY: compiled with AVX2, which the caller guarantees.
+        unsafe { traverse::closest(Avx2, nodes, depth, ray, leaves, counters) }
+    }
+
+    /// # Safety
+    /// The processor has AVX-512 F, VL, BW and DQ (and AVX2).
+    #[target_feature(enable = "avx2,fma,avx512f,avx512vl,avx512bw,avx512dq")]
+    pub unsafe fn closest_avx512<C: Counters, L: Leaves<C>>(
+        nodes: &[WideNode],
+        depth: u32,
+        ray: &NodeRay,
+        leaves: &mut L,
+        counters: &mut C,
+    ) {
+        // SAFETY: compiled with AVX-512, which the caller guarantees.
+        unsafe { traverse::closest(Avx512, nodes, depth, ray, leaves, counters) }
+    }
+
+    /// # Safety
+    /// The processor has AVX2 and FMA.
+    #[target_feature(enable = "avx2,fma")]
+    pub unsafe fn any_avx2<C: Counters, L: Leaves<C>>(
+        nodes: &[WideNode],
+        depth: u32,
+        ray: &NodeRay,
+        limit: f32,
+        leaves: &mut L,
+        counters: &mut C,
+    ) -> bool {
+        // SAFETY: compiled with AVX2, which the caller guarantees.
+        unsafe { traverse::any(Avx2, nodes, depth, ray, limit, leaves, counters) }
+    }
+
+    /// # Safety
+    /// The processor has AVX-512 F, VL, BW and DQ (and AVX2).
+    #[target_feature(enable = "avx2,fma,avx512f,avx512vl,avx512bw,avx512dq")]
+    pub unsafe fn any_avx512<C: Counters, L: Leaves<C>>(
+        nodes: &[WideNode],
+        depth: u32,
+        ray: &NodeRay,
+        limit: f32,
+        leaves: &mut L,
+        counters: &mut C,
+    ) -> bool {
+        // SAFETY: compiled with AVX-512, which the caller guarantees.
+        unsafe { traverse::any(Avx512, nodes, depth, ray, limit, leaves, counters) }
+    }
+}

@@ -1,0 +1,192 @@
+//! The slab test of a wide node's eight children at once, one implementation per instruction set
+//! (see [`super::isa`]). Each computes, per child, exactly what the scalar robust slab test
+//! computes ([`super::node::child_entry_scalar`], Williams, Barrus, Morley and Shirley (2005) with
+//! the far distance scaled as in Ize (2013), "Robust BVH Ray Traversal"): the same subtractions and
+//! products in the same order, and the same handling of NaN (an origin on the plane of a parallel
+//! ray leaves the interval unchanged). The x86 `max`/`min` instructions return their second operand
+//! when either is NaN, which is the scalar test's `if t_near > enter { t_near } else { enter }`;
+//! the portable kernel spells that comparison out, because NEON's `max` propagates NaN instead.
+//!
+//! The kernels are `unsafe` only because the x86 ones need their instruction set: a kernel may be
+//! called only from code compiled with its target features, on a processor that has them, which
+//! the dispatch in [`super::traverse`] guarantees.
+
+use glam::Vec4;
+
+use super::node::{NodeRay, WIDTH, WideNode};
+use crate::aabb::ROBUST_FAR_SCALE;
+
+/// A slab test of all children of a node.
+pub trait NodeKernel: Copy {
+    /// Tests the ray against the eight children's boxes within `t_min..=limit`: bit `i` of the
+    /// result is set if child `i` is entered, and `dist[i]` is then its entry distance.
+    ///
+    /// # Safety
+    /// The caller is compiled with the kernel's target features and runs on a processor that
+    /// has them.
+    unsafe fn children(self, node: &WideNode, ray: &NodeRay, limit: f32, dist: &mut [f32; WIDTH]) -> u32;
+}
+
+/// Four lanes at a time through glam (SSE2 on x86-64, NEON on aarch64, scalar elsewhere).
+#[derive(Clone, Copy, Debug)]
+pub struct Portable;
+
+impl NodeKernel for Portable {
+    #[inline(always)]
+    unsafe fn children(self, node: &WideNode, ray: &NodeRay, limit: f32, dist: &mut [f32; WIDTH]) -> u32 {
+        let mut mask = 0;
+        for half in 0..2 {
+            let row = |r: usize| Vec4::from_slice(&node.bounds[r][4 * half..4 * half + 4]);
+            let (mut enter, mut exit) = (Vec4::splat(ray.t_min), Vec4::splat(limit));
+            for a in 0..3 {
+                let (o, inv) = (Vec4::splat(ray.origin[a]), Vec4::splat(ray.inv_dir[a]));
+                let t_near = (row(ray.near[a]) - o) * inv;
+                let t_far = (row(ray.far[a]) - o) * inv * ROBUST_FAR_SCALE;
+                enter = Vec4::select(t_near.cmpgt(enter), t_near, enter);
+                exit = Vec4::select(t_far.cmplt(exit), t_far, exit);
+            }
+            mask |= enter.cmple(exit).bitmask() << (4 * half);
+            enter.write_to_slice(&mut dist[4 * half..4 * half + 4]);
+        }
+        mask
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+pub use x86::{Avx2, Avx512};
+
+#[cfg(target_arch = "x86_64")]
+mod x86 {
+    use std::arch::x86_64::*;
+
+    use super::{NodeKernel, NodeRay, ROBUST_FAR_SCALE, WIDTH, WideNode};
+
+    /// Eight lanes with AVX2.
+    #[derive(Clone, Copy, Debug)]
+    pub struct Avx2;
+
+    /// Entry and exit distances of the eight children.
+    #[inline(always)]
+    unsafe fn slabs(node: &WideNode, ray: &NodeRay, limit: f32) -> (__m256, __m256) {
+        // SAFETY (for the whole function): the caller guarantees AVX; every row is 32 bytes
+        // inside a node aligned to 64, so the aligned loads are in bounds and aligned.
+        unsafe {
+            let scale = _mm256_set1_ps(ROBUST_FAR_SCALE);
+            let mut enter = _mm256_set1_ps(ray.t_min);
+            let mut exit = _mm256_set1_ps(limit);
+            for a in 0..3 {
+                let o = _mm256_set1_ps(ray.origin[a]);
+                let inv = _mm256_set1_ps(ray.inv_dir[a]);
+                // The rows from the direction's sign bit (as `NodeRay::near` and `far` hold
+                // them): indices the compiler sees are in bounds, so no check per row.
+                let down = (ray.negative_bits >> a & 1) as usize;
+                let near = _mm256_load_ps(node.bounds[2 * a + down].as_ptr());
+                let far = _mm256_load_ps(node.bounds[2 * a + 1 - down].as_ptr());
+                let t_near = _mm256_mul_ps(_mm256_sub_ps(near, o), inv);
+                let t_far = _mm256_mul_ps(_mm256_mul_ps(_mm256_sub_ps(far, o), inv), scale);
+                // `max(a, b)` is `a > b ? a : b`, `b` when either is NaN: the scalar rule.
+                enter = _mm256_max_ps(t_near, enter);
+                exit = _mm256_min_ps(t_far, exit);
+            }
+            (enter, exit)
+        }
+    }
+
+    impl NodeKernel for Avx2 {
+        #[inline(always)]
+        unsafe fn children(self, node: &WideNode, ray: &NodeRay, limit: f32, dist: &mut [f32; WIDTH]) -> u32 {
+            // SAFETY: AVX2 is guaranteed by the caller; `dist` holds eight floats.
+            unsafe {
+                let (enter, exit) = slabs(node, ray, limit);
+                _mm256_storeu_ps(dist.as_mut_ptr(), enter);
+                _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(enter, exit)) as u32
+            }
+        }
+    }
+
+    /// Eight lanes with AVX-512 (VL): the comparison lands in a mask register.
+    #[derive(Clone, Copy, Debug)]
+    pub struct Avx512;
+
+    impl NodeKernel for Avx512 {
+        #[inline(always)]
+        unsafe fn children(self, node: &WideNode, ray: &NodeRay, limit: f32, dist: &mut [f32; WIDTH]) -> u32 {
+            // SAFETY: AVX-512 F and VL are guaranteed by the caller; `dist` holds eight floats.
+            unsafe {
+                let (enter, exit) = slabs(node, ray, limit);
+                _mm256_storeu_ps(dist.as_mut_ptr(), enter);
+                _mm256_cmp_ps_mask::<_CMP_LE_OQ>(enter, exit) as u32
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::Vec3;
+
+    use super::*;
+    use crate::accel::wide::isa::Isa;
+    use crate::accel::wide::node::{child_entry_scalar, reach};
+    use crate::{Aabb, Ray};
+
+    /// Runs `kernel` on the node for every ray and compares with the scalar test, bit for bit.
+    fn check(isa: Isa, node: &WideNode, ray: &Ray) -> u32 {
+        let r = NodeRay::new(ray);
+        let limit = reach(ray.t_max);
+        let mut dist = [0.0; WIDTH];
+        // SAFETY: each kernel runs only if the processor has its instruction set; the test
+        // binary is not compiled with them, but calling the kernel (not inlined then) is sound.
+        let mask = unsafe {
+            match isa {
+                Isa::Portable => Portable.children(node, &r, limit, &mut dist),
+                #[cfg(target_arch = "x86_64")]
+                Isa::Avx2 => Avx2.children(node, &r, limit, &mut dist),
+                #[cfg(target_arch = "x86_64")]
+                Isa::Avx512 => Avx512.children(node, &r, limit, &mut dist),
+                #[cfg(not(target_arch = "x86_64"))]
+                _ => unreachable!(),
+            }
+        };
+        for (slot, &d) in dist.iter().enumerate() {
+            let expected = child_entry_scalar(node, slot, &r, limit);
+            let got = (mask >> slot & 1 != 0).then_some(d);
+            assert_eq!(expected.map(f32::to_bits), got.map(f32::to_bits), "{isa}: slot {slot} of {node:?}, {ray:?}");
+        }
+        mask.count_ones()
+    }
+
+    #[test]
+    fn every_kernel_agrees_bit_for_bit_with_the_scalar_test() {
+        // Integer coordinates and axis-parallel directions of both signs, zeros of both signs,
+        // so that origins on planes, rays in faces and flat boxes all occur.
+        let mut s = 0x1234_5678u32;
+        let mut next = move |n: u32| {
+            s ^= s << 13;
+            s ^= s >> 17;
+            s ^= s << 5;
+            s % n
+        };
+        let values = [-2.0f32, -1.0, -0.0, 0.0, 0.5, 1.0, 2.0];
+        let dirs = [-1.0f32, -0.0, 0.0, 0.3, 1.0];
+        for isa in Isa::available() {
+            let mut hits = 0;
+            for _ in 0..20_000 {
+                let children = 1 + next(WIDTH as u32) as usize;
+                let t_max = [f32::INFINITY, 1.0, 2.5][next(3) as usize];
+                let mut pick = |v: &[f32]| v[next(v.len() as u32) as usize];
+                let mut node = WideNode::EMPTY_NODE;
+                for slot in 0..children {
+                    let a = Vec3::new(pick(&values), pick(&values), pick(&values));
+                    let b = Vec3::new(pick(&values), pick(&values), pick(&values));
+                    node.set_child(slot, &Aabb::new(a.min(b), a.max(b)), slot as u32, 0);
+                }
+                let origin = Vec3::new(pick(&values), pick(&values), pick(&values)) * 1.5;
+                let dir = Vec3::new(pick(&dirs), pick(&dirs), pick(&dirs));
+                hits += check(isa, &node, &Ray::segment(origin, dir, 0.0, t_max));
+            }
+            // About one box in fourteen is entered: enough of both outcomes.
+            assert!(hits > 3_000, "{isa}: {hits}");
+        }
+    }
+}

@@ -1,0 +1,317 @@
+//! The wide BVH: eight children per node, all eight boxes tested at once with SIMD, converted from
+//! the canonical binary [`Bvh`]. Wald, Benthin and Boulos (2008), "Getting Rid of Packets:
+//! Efficient SIMD Single-Ray Traversal using Multi-branching BVHs"; the layout and traversal of
+//! Embree's `BVH8` (Wald, Woop, Benthin, Johnson and Ernst 2014, "Embree: A Kernel Framework for
+//! Efficient CPU Ray Tracing").
+//!
+//! Two structures share the nodes and the traversal:
+//!
+//! * [`WideBvh`], behind the [`Accel`] interface like every other structure: leaves hold primitive
+//!   references, tested by the query's closure. `--accel bvh-wide`.
+//! * [`TriangleBvh`], for triangle meshes: leaves hold the triangles themselves in blocks of four,
+//!   tested with a SIMD watertight test. The fast path.
+//!
+//! Files:
+//!
+//! * [`node`]: the 256-byte node, child references, the scalar reference slab test.
+//! * [`convert`]: binary tree to wide nodes (largest boxes pulled up first).
+//! * [`isa`]: the instruction sets, detected at run time; [`kernels`]: the slab test of eight
+//!   children for each; [`dispatch`]: the per-query choice.
+//! * [`traverse`]: the single-ray traversal, generic over kernels and leaves.
+//! * [`triangles`]: blocks of four triangles and their SIMD watertight test; [`triangle_bvh`]:
+//!   [`TriangleBvh`].
+
+pub mod convert;
+pub mod dispatch;
+pub mod isa;
+pub mod kernels;
+pub mod node;
+pub mod traverse;
+pub mod triangle_bvh;
+pub mod triangles;
+
+pub use isa::{Isa, IsaUnavailable};
+pub use triangle_bvh::{TriangleBvh, TriangleBvhOptions};
+
+use convert::{ConvertOptions, LeafSink, convert};
+use node::{EMPTY, MAX_LEAF_ITEMS, NodeRay, WIDTH, WideNode, index_of, is_leaf, reach};
+use traverse::Leaves;
+
+use super::bvh::{BinnedSah, Bvh};
+use super::{Accel, Counters, Hit, HitRecord, LEAF_SIZE_BUCKETS, StructureStats};
+use crate::shapes::PrimHit;
+use crate::{Aabb, Ray};
+
+/// A wide BVH whose leaves hold primitive references, queried through closures like every
+/// [`Accel`]. Built from the binned SAH tree; leaves are the binary tree's.
+#[derive(Clone, Debug)]
+pub struct WideBvh {
+    nodes: Vec<WideNode>,
+    prim_indices: Vec<u32>,
+    depth: u32,
+    bounds: Aabb,
+    isa: Isa,
+}
+
+/// Stores leaves as ranges of primitive references.
+struct References(Vec<u32>);
+
+impl LeafSink for References {
+    fn max_prims(&self) -> usize {
+        MAX_LEAF_ITEMS
+    }
+
+    fn leaf(&mut self, prims: &[u32]) -> (u32, u8) {
+        let first = self.0.len() as u32;
+        self.0.extend_from_slice(prims);
+        (first, prims.len() as u8)
+    }
+}
+
+impl WideBvh {
+    /// The binned SAH tree over the boxes, made wide.
+    pub fn build(boxes: &[Aabb]) -> Self {
+        Self::from_bvh(&BinnedSah::default().build(boxes))
+    }
+
+    /// Any binary tree made wide, its leaves kept (split if larger than a leaf reference holds).
+    pub fn from_bvh(bvh: &Bvh) -> Self {
+        let mut sink = References(Vec::with_capacity(bvh.prim_indices().len()));
+        let layout = convert(bvh, ConvertOptions { collapse: 0 }, &mut sink);
+        WideBvh {
+            nodes: layout.nodes,
+            prim_indices: sink.0,
+            depth: layout.depth,
+            bounds: bvh.bounds(),
+            isa: Isa::best(),
+        }
+    }
+
+    /// The instruction set queries run with.
+    pub fn isa(&self) -> Isa {
+        self.isa
+    }
+
+    /// Runs queries with `isa` from now on, if the processor has it.
+    pub fn set_isa(&mut self, isa: Isa) -> Result<(), IsaUnavailable> {
+        if !isa.is_available() {
+            return Err(IsaUnavailable(isa));
+        }
+        self.isa = isa;
+        Ok(())
+    }
+
+    /// The nodes (the root is node 0).
+    pub fn nodes(&self) -> &[WideNode] {
+        &self.nodes
+    }
+
+    /// The leaves' primitive references.
+    pub fn prim_indices(&self) -> &[u32] {
+        &self.prim_indices
+    }
+
+    /// Wide nodes on the longest path from the root to a leaf.
+    pub fn depth(&self) -> u32 {
+        self.depth
+    }
+
+    /// Checks the tree: every node reached once from the root, every primitive of `boxes` in
+    /// exactly one leaf, child boxes inside their parent's, leaf boxes around their primitives,
+    /// the recorded depth.
+    pub fn validate(&self, boxes: &[Aabb]) -> Result<(), String> {
+        let mut seen = vec![0u32; boxes.len()];
+        let mut reached = vec![false; self.nodes.len()];
+        let mut depth = 0;
+        let mut stack = vec![(0u32, self.bounds, 1u32)];
+        if self.nodes.is_empty() {
+            stack.clear();
+        }
+        while let Some((i, parent, level)) = stack.pop() {
+            let node = self.nodes.get(i as usize).ok_or(format!("child {i} is not a node"))?;
+            if std::mem::replace(&mut reached[i as usize], true) {
+                return Err(format!("node {i} is reached twice"));
+            }
+            depth = depth.max(level);
+            for slot in (0..WIDTH).filter(|&s| node.children[s] != EMPTY) {
+                let b = node.child_bounds(slot);
+                if !parent.contains_box(&b) {
+                    return Err(format!("node {i}, slot {slot}: {b:?} is not inside {parent:?}"));
+                }
+                let c = node.children[slot];
+                if !is_leaf(c) {
+                    stack.push((c, b, level + 1));
+                    continue;
+                }
+                let first = index_of(c) as usize;
+                let range = first..first + node.counts[slot] as usize;
+                let prims = self.prim_indices.get(range).ok_or(format!("node {i}, slot {slot}: bad leaf range"))?;
+                if prims.is_empty() {
+                    return Err(format!("node {i}, slot {slot}: empty leaf"));
+                }
+                for &p in prims {
+                    let pb = boxes.get(p as usize).ok_or(format!("primitive {p} does not exist"))?;
+                    if !b.contains_box(pb) {
+                        return Err(format!("primitive {p} sticks out of its leaf (node {i}, slot {slot})"));
+                    }
+                    seen[p as usize] += 1;
+                }
+            }
+        }
+        if let Some(p) = seen.iter().position(|&s| s != 1) {
+            return Err(format!("primitive {p} is in {} leaves", seen[p]));
+        }
+        if let Some(n) = reached.iter().position(|&r| !r) {
+            return Err(format!("node {n} is not reachable"));
+        }
+        if depth != self.depth {
+            return Err(format!("recorded depth {}, real depth {depth}", self.depth));
+        }
+        Ok(())
+    }
+}
+
+/// A query's view of the primitive references, its closure and its closest hit so far.
+struct ClosureLeaves<'a, F> {
+    prims: &'a [u32],
+    record: HitRecord,
+    test: F,
+}
+
+impl<C: Counters, F: FnMut(u32, &Ray) -> Option<PrimHit>> Leaves<C> for ClosureLeaves<'_, F> {
+    #[inline(always)]
+    fn closest(&mut self, first: u32, count: u32, counters: &mut C) {
+        for &prim in &self.prims[first as usize..(first + count) as usize] {
+            counters.exact_test();
+            if let Some(hit) = (self.test)(prim, &self.record.ray) {
+                self.record.offer(prim, hit);
+            }
+        }
+    }
+
+    #[inline(always)]
+    fn t_max(&self) -> f32 {
+        self.record.ray.t_max
+    }
+
+    #[inline(always)]
+    fn any(&mut self, first: u32, count: u32, counters: &mut C) -> bool {
+        for &prim in &self.prims[first as usize..(first + count) as usize] {
+            counters.exact_test();
+            if (self.test)(prim, &self.record.ray).is_some() {
+                return true;
+            }
+        }
+        false
+    }
+}
+
+impl Accel for WideBvh {
+    fn bounds(&self) -> Aabb {
+        self.bounds
+    }
+
+    #[inline]
+    fn closest_hit<C: Counters>(
+        &self,
+        ray: &Ray,
+        counters: &mut C,
+        intersect: impl FnMut(u32, &Ray) -> Option<PrimHit>,
+    ) -> Option<Hit> {
+        if !ray.is_valid() || self.nodes.is_empty() {
+            return None;
+        }
+        let mut leaves = ClosureLeaves { prims: &self.prim_indices, record: HitRecord::new(*ray), test: intersect };
+        dispatch::closest(self.isa, &self.nodes, self.depth, &NodeRay::new(ray), &mut leaves, counters);
+        leaves.record.hit
+    }
+
+    #[inline]
+    fn any_hit<C: Counters>(&self, ray: &Ray, counters: &mut C, mut occludes: impl FnMut(u32, &Ray) -> bool) -> bool {
+        if !ray.is_valid() || self.nodes.is_empty() {
+            return false;
+        }
+        let test = |prim: u32, r: &Ray| occludes(prim, r).then_some(PrimHit::at(0.0));
+        let mut leaves = ClosureLeaves { prims: &self.prim_indices, record: HitRecord::new(*ray), test };
+        dispatch::any(self.isa, &self.nodes, self.depth, &NodeRay::new(ray), reach(ray.t_max), &mut leaves, counters)
+    }
+
+    fn stats(&self) -> StructureStats {
+        let mut leaf_sizes = [0; LEAF_SIZE_BUCKETS];
+        let mut leaves = 0;
+        for node in &self.nodes {
+            for slot in (0..WIDTH).filter(|&s| node.children[s] != EMPTY && is_leaf(node.children[s])) {
+                leaf_sizes[(node.counts[slot] as usize).clamp(1, LEAF_SIZE_BUCKETS) - 1] += 1;
+                leaves += 1;
+            }
+        }
+        StructureStats {
+            nodes: self.nodes.len(),
+            leaves,
+            depth: self.depth as usize,
+            prim_refs: self.prim_indices.len(),
+            memory_bytes: std::mem::size_of::<Self>()
+                + std::mem::size_of_val(self.nodes.as_slice())
+                + std::mem::size_of_val(self.prim_indices.as_slice()),
+            sah_cost: None,
+            leaf_sizes,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::Vec3;
+
+    use super::traverse::INLINE_DEPTH;
+    use super::*;
+    use crate::accel::bvh::{BuildKind, BuildNode, BuildTree};
+    use crate::accel::{AccelKind, AnyAccel, NoCount};
+    use crate::shapes::AaBox;
+
+    /// A chain: interior node `k` holds leaf `k` and node `k + 1`, so the wide tree is about
+    /// `n / 7` nodes deep, and queries use the per-thread stack instead of the inline one.
+    fn chain(n: u32) -> (Vec<Aabb>, Bvh) {
+        let boxes: Vec<Aabb> =
+            (0..n).map(|i| Aabb::new(Vec3::new(i as f32, 0.0, 0.0), Vec3::new(i as f32 + 0.5, 1.0, 1.0))).collect();
+        let mut nodes: Vec<BuildNode> = boxes
+            .iter()
+            .enumerate()
+            .map(|(i, &b)| BuildNode { bounds: b, kind: BuildKind::Leaf { first: i as u32, count: 1 } })
+            .collect();
+        for i in 0..n - 1 {
+            let bounds = Aabb::new(Vec3::new(i as f32, 0.0, 0.0), Vec3::new(n as f32, 1.0, 1.0));
+            let next = if i + 1 == n - 1 { n - 1 } else { n + i + 1 };
+            nodes.push(BuildNode { bounds, kind: BuildKind::Interior { children: [i, next] } });
+        }
+        let bvh = BuildTree { nodes, prims: (0..n).collect(), root: n }.into_bvh();
+        (boxes, bvh)
+    }
+
+    #[test]
+    fn trees_deeper_than_the_inline_stack_agree_with_brute_force() {
+        let (boxes, bvh) = chain(600);
+        let mut wide = WideBvh::from_bvh(&bvh);
+        wide.validate(&boxes).unwrap();
+        assert!(wide.depth() as usize > INLINE_DEPTH, "depth {}", wide.depth());
+        let shapes: Vec<AaBox> = boxes.iter().map(|b| AaBox::new(b.min, b.max)).collect();
+        let test = |i: u32, r: &Ray| crate::shapes::Intersect::intersect(&shapes[i as usize], r);
+        let brute = AnyAccel::build(AccelKind::None, &boxes);
+        let rays: Vec<Ray> = (0..50)
+            .flat_map(|k| {
+                let y = 0.1 + k as f32 * 0.015;
+                [Ray::new(Vec3::new(700.0, y, 0.5), -Vec3::X), Ray::new(Vec3::new(-1.0, y, 0.5), Vec3::X)]
+            })
+            .chain([Ray::segment(Vec3::new(300.25, 0.5, 0.5), Vec3::X, 0.0, 3.0)])
+            .collect();
+        for isa in Isa::available() {
+            wide.set_isa(isa).unwrap();
+            for r in &rays {
+                let expected = brute.closest_hit(r, &mut NoCount, test);
+                assert_eq!(wide.closest_hit(r, &mut NoCount, test), expected, "{isa}: {r:?}");
+                assert!(expected.is_some());
+                assert!(wide.any_hit(r, &mut NoCount, |i, r| test(i, r).is_some()), "{isa}: {r:?}");
+            }
+        }
+    }
+}

@@ -1,0 +1,199 @@
+//! The node of the wide BVH: eight children's boxes stored as a structure of arrays, so that one
+//! SIMD instruction handles the same plane of all eight boxes, and the children's references.
+//!
+//! This is the multi-BVH node of Wald, Benthin and Boulos (2008), "Getting Rid of Packets:
+//! Efficient SIMD Single-Ray Traversal using Multi-branching BVHs" (IEEE Symposium on Interactive
+//! Ray Tracing), at the width of Embree's `BVH8` (Wald, Woop, Benthin, Johnson and Ernst 2014,
+//! "Embree: A Kernel Framework for Efficient CPU Ray Tracing", ACM TOG 33(4)): one 256-byte node,
+//! four cache lines, aligned so that each row of eight floats is one aligned AVX load.
+//!
+//! A child reference is a `u32`: the index of an interior node, or [`LEAF`] plus the index of the
+//! leaf's first item (a primitive reference or a block of triangles, depending on the structure),
+//! with the number of items in [`WideNode::counts`]. Unused slots have [`EMPTY`] and an empty box
+//! (`+inf` below, `-inf` above) that no ray enters: the slab test rejects it without a special case.
+
+use crate::aabb::ROBUST_FAR_SCALE;
+use crate::{Aabb, Ray};
+
+/// Children per node.
+pub const WIDTH: usize = 8;
+
+/// Flag of a child reference naming a leaf.
+pub const LEAF: u32 = 1 << 31;
+
+/// The reference of an unused child slot.
+pub const EMPTY: u32 = u32::MAX;
+
+/// Most items one leaf reference can hold (its count is a byte).
+pub const MAX_LEAF_ITEMS: usize = u8::MAX as usize;
+
+/// Rows of [`WideNode::bounds`]: lower x, upper x, lower y, upper y, lower z, upper z.
+pub const ROWS: usize = 6;
+
+/// One node: eight children's boxes (row `2 * axis` the lower planes, `2 * axis + 1` the upper
+/// planes, column = child slot) and references.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C, align(64))]
+pub struct WideNode {
+    /// The children's planes, one row of eight per plane (see [`ROWS`]).
+    pub bounds: [[f32; WIDTH]; ROWS],
+    /// The children: an interior node's index, [`LEAF`] plus a first item, or [`EMPTY`].
+    pub children: [u32; WIDTH],
+    /// Items of each leaf child (0 for interior and empty slots).
+    pub counts: [u8; WIDTH],
+}
+
+const _: () = assert!(std::mem::size_of::<WideNode>() == 256);
+
+impl WideNode {
+    /// A node with every slot empty.
+    pub const EMPTY_NODE: WideNode = WideNode {
+        bounds: [
+            [f32::INFINITY; WIDTH],
+            [f32::NEG_INFINITY; WIDTH],
+            [f32::INFINITY; WIDTH],
+            [f32::NEG_INFINITY; WIDTH],
+            [f32::INFINITY; WIDTH],
+            [f32::NEG_INFINITY; WIDTH],
+        ],
+        children: [EMPTY; WIDTH],
+        counts: [0; WIDTH],
+    };
+
+    /// Puts a child in slot `slot`: its box, its reference, and its item count (leaves only).
+    pub fn set_child(&mut self, slot: usize, bounds: &Aabb, reference: u32, count: u8) {
+        for axis in 0..3 {
+            self.bounds[2 * axis][slot] = bounds.min[axis];
+            self.bounds[2 * axis + 1][slot] = bounds.max[axis];
+        }
+        self.children[slot] = reference;
+        self.counts[slot] = count;
+    }
+
+    /// The box of slot `slot` (the empty box for an unused slot).
+    pub fn child_bounds(&self, slot: usize) -> Aabb {
+        let b = &self.bounds;
+        Aabb::new(
+            glam::Vec3::new(b[0][slot], b[2][slot], b[4][slot]),
+            glam::Vec3::new(b[1][slot], b[3][slot], b[5][slot]),
+        )
+    }
+
+    /// Number of used slots.
+    pub fn child_count(&self) -> usize {
+        self.children.iter().filter(|&&c| c != EMPTY).count()
+    }
+}
+
+/// Whether a child reference names a leaf (an unused slot's does too, but no ray reaches it).
+#[inline(always)]
+pub fn is_leaf(reference: u32) -> bool {
+    reference & LEAF != 0
+}
+
+/// The index a child reference carries: the interior node's, or the leaf's first item.
+#[inline(always)]
+pub fn index_of(reference: u32) -> u32 {
+    reference & !LEAF
+}
+
+/// A ray prepared for the slab tests of wide nodes: which row is the near plane on each axis, by
+/// the sign of the inverse direction, exactly as [`Aabb::slab_distances`] chooses it.
+#[derive(Clone, Copy, Debug)]
+pub struct NodeRay {
+    /// The ray's origin.
+    pub origin: [f32; 3],
+    /// Its inverse direction (`+inf` for zero components).
+    pub inv_dir: [f32; 3],
+    /// Row of the near plane on each axis.
+    pub near: [usize; 3],
+    /// Row of the far plane on each axis.
+    pub far: [usize; 3],
+    /// The ray's `t_min`.
+    pub t_min: f32,
+    /// Bit `a` set if the ray goes down axis `a`.
+    pub negative_bits: u32,
+}
+
+impl NodeRay {
+    /// Prepares `ray`.
+    #[inline(always)]
+    pub fn new(ray: &Ray) -> Self {
+        let inv = ray.inv_dir().to_array();
+        let mut near = [0; 3];
+        let mut far = [0; 3];
+        let mut negative_bits = 0;
+        for a in 0..3 {
+            let down = !(inv[a] >= 0.0);
+            near[a] = 2 * a + down as usize;
+            far[a] = 2 * a + 1 - down as usize;
+            negative_bits |= (down as u32) << a;
+        }
+        NodeRay { origin: ray.origin().to_array(), inv_dir: inv, near, far, t_min: ray.t_min, negative_bits }
+    }
+}
+
+/// How far along the ray a box may begin and still be entered, when the closest hit so far is at
+/// `t_max`: a little beyond it, by the rounding bound of the slab test, as the binary traversal
+/// does (see [`crate::accel::bvh::ordered`]): a primitive of lower index hit at exactly `t_max`
+/// on the face of a box entered there must still win the tie.
+#[inline(always)]
+pub fn reach(t_max: f32) -> f32 {
+    t_max + t_max.abs() * (ROBUST_FAR_SCALE - 1.0)
+}
+
+/// The slab test of one child, one plane at a time, as [`Aabb::slab_distances`] computes it: the
+/// reference every SIMD kernel must match bit for bit. Returns the entry distance if the ray
+/// enters the box within `t_min..=limit`.
+#[inline(always)]
+pub fn child_entry_scalar(node: &WideNode, slot: usize, ray: &NodeRay, limit: f32) -> Option<f32> {
+    let (mut enter, mut exit) = (ray.t_min, limit);
+    for a in 0..3 {
+        let t_near = (node.bounds[ray.near[a]][slot] - ray.origin[a]) * ray.inv_dir[a];
+        let t_far = (node.bounds[ray.far[a]][slot] - ray.origin[a]) * ray.inv_dir[a] * ROBUST_FAR_SCALE;
+        enter = if t_near > enter { t_near } else { enter };
+        exit = if t_far < exit { t_far } else { exit };
+    }
+    (enter <= exit).then_some(enter)
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::Vec3;
+
+    use super::*;
+
+    #[test]
+    fn empty_slots_are_never_entered() {
+        let node = WideNode::EMPTY_NODE;
+        for dir in [Vec3::X, -Vec3::Y, Vec3::new(0.0, -0.0, 1.0), Vec3::new(-1.0, 2.0, -3.0)] {
+            for (t_min, t_max) in [(0.0, f32::INFINITY), (f32::NEG_INFINITY, f32::INFINITY), (-1.0, 1.0)] {
+                let ray = Ray::segment(Vec3::new(0.5, -2.0, 3.0), dir, t_min, t_max);
+                let r = NodeRay::new(&ray);
+                for slot in 0..WIDTH {
+                    assert_eq!(child_entry_scalar(&node, slot, &r, reach(t_max)), None);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn the_scalar_child_test_is_the_box_test() {
+        let b = Aabb::new(Vec3::new(-1.0, 0.0, 2.0), Vec3::new(1.0, 0.5, 3.0));
+        let mut node = WideNode::EMPTY_NODE;
+        node.set_child(3, &b, 7, 0);
+        assert_eq!(node.child_bounds(3), b);
+        assert_eq!(node.child_count(), 1);
+        for (o, d) in [(Vec3::ZERO, Vec3::Z), (Vec3::new(0.0, 0.25, 10.0), -Vec3::Z), (Vec3::ZERO, Vec3::X)] {
+            let ray = Ray::new(o, d);
+            let expected = b.intersect(&ray).map(|(t, _)| t);
+            assert_eq!(child_entry_scalar(&node, 3, &NodeRay::new(&ray), f32::INFINITY), expected);
+        }
+    }
+
+    #[test]
+    fn near_rows_follow_the_direction_signs() {
+        let r = NodeRay::new(&Ray::new(Vec3::ZERO, Vec3::new(-1.0, 0.0, -0.0)));
+        assert_eq!((r.near, r.far, r.negative_bits), ([1, 2, 4], [0, 3, 5], 0b001));
+    }
+}

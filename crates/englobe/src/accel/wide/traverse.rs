@@ -1,0 +1,292 @@
+//! Single-ray traversal of the wide BVH: all eight children of a node tested at once, the hit
+//! ones entered nearest first, the others kept on a stack with their entry distances and dropped
+//! without another test if a closer hit is found before they are popped. This is the traversal
+//! of Wald, Benthin and Boulos (2008), "Getting Rid of Packets: Efficient SIMD Single-Ray
+//! Traversal using Multi-branching BVHs", in the form Embree's `BVHNIntersector1` gives it (Wald
+//! et al. 2014): no sorting at all when one child or two are hit (the common cases), a short
+//! insertion sort of the hit children otherwise.
+//!
+//! Occlusion queries stop at the first occluder and do not sort: they enter the nearest child hit
+//! first (the likeliest to hold an occluder) and push the others as they come.
+//!
+//! The traversal is generic over the node test ([`NodeKernel`], one per instruction set) and over
+//! what leaves hold ([`Leaves`]: primitive references tested by a closure, or blocks of
+//! triangles). [`dispatch`] calls the instance compiled for the structure's instruction set.
+//!
+//! The stack holds at most seven entries per level of the path from the root, so the tree's
+//! recorded depth bounds it: trees up to [`INLINE_DEPTH`] levels deep use an uninitialised array on
+//! the call stack (no per-query cost to clear it); deeper ones (only degenerate builds are) a buffer
+//! kept per thread and grown once. No query allocates in the steady state.
+
+use std::cell::Cell;
+use std::mem::MaybeUninit;
+
+use super::kernels::NodeKernel;
+use super::node::{NodeRay, WIDTH, WideNode, index_of, is_leaf, reach};
+use crate::accel::Counters;
+
+/// Depth (in wide nodes) up to which the stack lives on the call stack.
+pub const INLINE_DEPTH: usize = 32;
+/// Entries of the inline stack.
+const INLINE_ENTRIES: usize = (WIDTH - 1) * INLINE_DEPTH + 1;
+
+/// A pending child: its reference, its leaf item count, and the distance at which the ray enters
+/// its box.
+#[derive(Clone, Copy, Debug)]
+pub struct Entry {
+    reference: u32,
+    count: u32,
+    t: f32,
+}
+
+/// What the leaves of a wide BVH hold, and how a query tests them.
+pub trait Leaves<C: Counters> {
+    /// Tests the `count` items from `first` for the closest hit, shrinking the interval.
+    fn closest(&mut self, first: u32, count: u32, counters: &mut C);
+    /// The end of the interval: the closest hit so far, or the ray's `t_max`.
+    fn t_max(&self) -> f32;
+    /// Whether any of the `count` items from `first` is hit.
+    fn any(&mut self, first: u32, count: u32, counters: &mut C) -> bool;
+    /// Starts loading the first item from `first` into the cache (a hint; nothing by default).
+    #[inline(always)]
+    fn prefetch(&self, first: u32) {
+        let _ = first;
+    }
+}
+
+/// Asks for every child of `node` in `mask` (the ones a ray enters), so that their cache misses
+/// overlap instead of following one another as the walk reaches them.
+#[inline(always)]
+fn prefetch_children<C: Counters, L: Leaves<C>>(nodes: &[WideNode], node: &WideNode, mut mask: u32, leaves: &L) {
+    while mask != 0 {
+        let i = mask.trailing_zeros() as usize;
+        mask &= mask - 1;
+        let c = node.children[i];
+        if is_leaf(c) {
+            leaves.prefetch(index_of(c));
+        } else {
+            prefetch_node(nodes, c);
+        }
+    }
+}
+
+/// Starts loading the node `index` into the cache (all four of its lines).
+#[inline(always)]
+fn prefetch_node(nodes: &[WideNode], index: u32) {
+    #[cfg(target_arch = "x86_64")]
+    if let Some(node) = nodes.get(index as usize) {
+        let p = node as *const WideNode as *const i8;
+        // SAFETY: prefetching is a hint that never faults; the addresses are inside the node.
+        unsafe {
+            use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
+            for line in 0..4 {
+                _mm_prefetch::<_MM_HINT_T0>(p.add(64 * line));
+            }
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = (nodes, index);
+}
+
+thread_local! {
+    /// The stack of queries on trees deeper than [`INLINE_DEPTH`], reused from query to query. A
+    /// query nested inside another's closure finds it taken and uses a fresh one.
+    static DEEP_STACK: Cell<Vec<MaybeUninit<Entry>>> = const { Cell::new(Vec::new()) };
+}
+
+/// A query's stack: `inline` if the tree is shallow enough, else the thread's deep stack, taken
+/// (left empty in its place) and grown to hold `(WIDTH - 1) * depth + 1` entries: each level of the
+/// path pushes at most seven, and the deepest briefly holds all eight of its children. Hand a
+/// taken stack back with [`give_back`].
+///
+/// Not a closure-taking helper on purpose: a closure's body is compiled without the caller's
+/// `#[target_feature]`s, and then every intrinsic in it becomes a call.
+#[inline(always)]
+fn stack_for<'a>(
+    depth: u32,
+    inline: &'a mut [MaybeUninit<Entry>; INLINE_ENTRIES],
+    deep: &'a mut Vec<MaybeUninit<Entry>>,
+) -> &'a mut [MaybeUninit<Entry>] {
+    let needed = (WIDTH - 1) * depth as usize + 1;
+    if needed <= INLINE_ENTRIES {
+        inline
+    } else {
+        *deep = DEEP_STACK.with(Cell::take);
+        deep.resize(needed.max(deep.len()), MaybeUninit::uninit());
+        deep
+    }
+}
+
+/// Returns a stack taken by [`stack_for`] to the thread, for the next deep query.
+#[inline(always)]
+fn give_back(deep: Vec<MaybeUninit<Entry>>) {
+    if deep.capacity() > 0 {
+        DEEP_STACK.with(|kept| kept.set(deep));
+    }
+}
+
+/// The closest hit: walks the tree from the root (node 0 of a non-empty `nodes`), asking `leaves`
+/// to test the leaves the ray reaches, nearest first.
+///
+/// # Safety
+/// As [`NodeKernel::children`]: compiled with the kernel's target features, run on a processor
+/// that has them.
+#[inline(always)]
+pub unsafe fn closest<K: NodeKernel, C: Counters, L: Leaves<C>>(
+    kernel: K,
+    nodes: &[WideNode],
+    depth: u32,
+    ray: &NodeRay,
+    leaves: &mut L,
+    counters: &mut C,
+) {
+    let mut inline = [const { MaybeUninit::<Entry>::uninit() }; INLINE_ENTRIES];
+    let mut deep = Vec::new();
+    let stack = stack_for(depth, &mut inline, &mut deep);
+    let mut len = 0usize;
+    let mut dist = [0.0f32; WIDTH];
+    let mut current = Entry { reference: 0, count: 0, t: 0.0 };
+    'walk: loop {
+        {
+            if is_leaf(current.reference) {
+                leaves.closest(index_of(current.reference), current.count, counters);
+            } else {
+                let node = &nodes[current.reference as usize];
+                counters.node_visited();
+                counters.box_tests(WIDTH as u32);
+                // SAFETY: the caller's guarantee.
+                let mut mask = unsafe { kernel.children(node, ray, reach(leaves.t_max()), &mut dist) };
+                prefetch_children(nodes, node, mask, leaves);
+                if mask != 0 {
+                    let first = mask.trailing_zeros() as usize;
+                    mask &= mask - 1;
+                    let a = Entry { reference: node.children[first], count: node.counts[first] as u32, t: dist[first] };
+                    if mask == 0 {
+                        current = a;
+                        continue;
+                    }
+                    let second = mask.trailing_zeros() as usize;
+                    mask &= mask - 1;
+                    let b =
+                        Entry { reference: node.children[second], count: node.counts[second] as u32, t: dist[second] };
+                    if mask == 0 {
+                        let (near, far) = if b.t < a.t { (b, a) } else { (a, b) };
+                        stack[len].write(far);
+                        len += 1;
+                        current = near;
+                        continue;
+                    }
+                    // Three or more: push them all, sort the pushed ones farthest first (an
+                    // insertion sort of at most eight), and take the nearest off the top.
+                    let base = len;
+                    stack[len].write(a);
+                    stack[len + 1].write(b);
+                    len += 2;
+                    while mask != 0 {
+                        let i = mask.trailing_zeros() as usize;
+                        mask &= mask - 1;
+                        stack[len].write(Entry {
+                            reference: node.children[i],
+                            count: node.counts[i] as u32,
+                            t: dist[i],
+                        });
+                        len += 1;
+                    }
+                    for i in base + 1..len {
+                        // SAFETY: entries below `len` were written.
+                        let e = unsafe { stack[i].assume_init() };
+                        let mut j = i;
+                        while j > base && unsafe { stack[j - 1].assume_init() }.t < e.t {
+                            stack[j] = stack[j - 1];
+                            j -= 1;
+                        }
+                        stack[j].write(e);
+                    }
+                    len -= 1;
+                    // SAFETY: written above.
+                    current = unsafe { stack[len].assume_init() };
+                    continue;
+                }
+            }
+            // Next pending child the ray still enters before the closest hit.
+            loop {
+                if len == 0 {
+                    break 'walk;
+                }
+                len -= 1;
+                // SAFETY: entries below `len` were written.
+                let e = unsafe { stack[len].assume_init() };
+                if e.t <= reach(leaves.t_max()) {
+                    current = e;
+                    break;
+                }
+            }
+        }
+    }
+    give_back(deep);
+}
+
+/// Whether any leaf item is hit: stops at the first one `leaves` reports.
+///
+/// # Safety
+/// As [`closest`].
+#[inline(always)]
+pub unsafe fn any<K: NodeKernel, C: Counters, L: Leaves<C>>(
+    kernel: K,
+    nodes: &[WideNode],
+    depth: u32,
+    ray: &NodeRay,
+    limit: f32,
+    leaves: &mut L,
+    counters: &mut C,
+) -> bool {
+    let mut inline = [const { MaybeUninit::<Entry>::uninit() }; INLINE_ENTRIES];
+    let mut deep = Vec::new();
+    let stack = stack_for(depth, &mut inline, &mut deep);
+    let mut len = 0usize;
+    let mut dist = [0.0f32; WIDTH];
+    let mut current = Entry { reference: 0, count: 0, t: 0.0 };
+    let hit = 'walk: loop {
+        {
+            if is_leaf(current.reference) {
+                if leaves.any(index_of(current.reference), current.count, counters) {
+                    break 'walk true;
+                }
+            } else {
+                let node = &nodes[current.reference as usize];
+                counters.node_visited();
+                counters.box_tests(WIDTH as u32);
+                // SAFETY: the caller's guarantee.
+                let mut mask = unsafe { kernel.children(node, ray, limit, &mut dist) };
+                prefetch_children(nodes, node, mask, leaves);
+                if mask != 0 {
+                    // The nearest child first (it is the likeliest to hold an occluder), the
+                    // others pushed as they come.
+                    let mut nearest = mask.trailing_zeros() as usize;
+                    mask &= mask - 1;
+                    while mask != 0 {
+                        let i = mask.trailing_zeros() as usize;
+                        mask &= mask - 1;
+                        let push = if dist[i] < dist[nearest] { std::mem::replace(&mut nearest, i) } else { i };
+                        stack[len].write(Entry {
+                            reference: node.children[push],
+                            count: node.counts[push] as u32,
+                            t: 0.0,
+                        });
+                        len += 1;
+                    }
+                    current = Entry { reference: node.children[nearest], count: node.counts[nearest] as u32, t: 0.0 };
+                    continue;
+                }
+            }
+            if len == 0 {
+                break 'walk false;
+            }
+            len -= 1;
+            // SAFETY: entries below `len` were written.
+            current = unsafe { stack[len].assume_init() };
+        }
+    };
+    give_back(deep);
+    hit
+}

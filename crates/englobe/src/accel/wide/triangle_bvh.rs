@@ -1,0 +1,313 @@
+//! [`TriangleBvh`]: the fast path for triangle meshes. A wide BVH whose leaves hold the triangles
+//! themselves, in blocks of four tested at once (see [`super::triangles`]), so that a query reads
+//! no index and calls no closure: closest hit and any hit of a ray, answered as `(t, triangle,
+//! u, v)`, exactly as the scalar watertight test and brute force would answer them.
+//!
+//! Built by the binned SAH builder ([`BinnedSah`], parallel), converted to eight-wide nodes
+//! ([`super::convert`]) with subtrees of up to four triangles collapsed into one block.
+
+use glam::Vec3;
+
+use super::convert::{ConvertOptions, LeafSink, convert};
+use super::dispatch;
+use super::isa::{Isa, IsaUnavailable};
+use super::node::{NodeRay, WideNode, reach};
+use super::traverse::Leaves;
+use super::triangles::{LANES, TriBlock, TriRay, UNUSED, intersect_block, is_storable};
+use crate::accel::bvh::BinnedSah;
+use crate::accel::bvh::parallel::fill_indexed;
+use crate::accel::{Counters, Hit, LEAF_SIZE_BUCKETS, MAX_PRIMITIVES, StructureStats};
+use crate::shapes::TriangleMesh;
+use crate::{Aabb, Ray};
+
+/// How a [`TriangleBvh`] is built.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TriangleBvhOptions {
+    /// The binary tree's builder.
+    pub builder: BinnedSah,
+    /// Binary subtrees over at most this many triangles become one leaf.
+    pub collapse: usize,
+}
+
+impl Default for TriangleBvhOptions {
+    fn default() -> Self {
+        TriangleBvhOptions { builder: BinnedSah { small_leaf: LANES, ..BinnedSah::default() }, collapse: LANES }
+    }
+}
+
+/// A wide BVH over triangles, stored inline in blocks of four: the structure for fast ray
+/// queries on meshes.
+///
+/// ```
+/// use englobe::{NoCount, Ray, TriangleBvh, TriangleMesh, Vec3};
+///
+/// let mesh = TriangleMesh::new(vec![Vec3::ZERO, Vec3::X, Vec3::Y], vec![[0, 1, 2]])?;
+/// let bvh = TriangleBvh::build(&mesh);
+/// let hit = bvh.closest_hit(&Ray::new(Vec3::new(0.25, 0.25, 1.0), -Vec3::Z), &mut NoCount).expect("a hit");
+/// assert_eq!((hit.prim, hit.t), (0, 1.0));
+/// # Ok::<(), englobe::shapes::MeshError>(())
+/// ```
+#[derive(Clone, Debug)]
+pub struct TriangleBvh {
+    nodes: Vec<WideNode>,
+    blocks: Vec<TriBlock>,
+    depth: u32,
+    bounds: Aabb,
+    /// Triangles stored (zero-area ones are left out: they are never hit).
+    stored: usize,
+    isa: Isa,
+}
+
+/// Packs leaves into blocks of four triangles.
+struct Blocks<'a, F> {
+    triangle: F,
+    ids: &'a [u32],
+    blocks: Vec<TriBlock>,
+    scratch: Vec<(u32, [Vec3; 3])>,
+}
+
+impl<F: Fn(u32) -> [Vec3; 3]> LeafSink for Blocks<'_, F> {
+    fn max_prims(&self) -> usize {
+        4 * LANES
+    }
+
+    fn leaf(&mut self, prims: &[u32]) -> (u32, u8) {
+        let first = self.blocks.len() as u32;
+        for chunk in prims.chunks(LANES) {
+            self.scratch.clear();
+            self.scratch.extend(chunk.iter().map(|&p| {
+                let id = self.ids[p as usize];
+                (id, (self.triangle)(id))
+            }));
+            self.blocks.push(TriBlock::new(&self.scratch));
+        }
+        (first, (self.blocks.len() as u32 - first) as u8)
+    }
+}
+
+impl TriangleBvh {
+    /// Builds the structure over the triangles of `mesh` (triangle indices are the mesh's).
+    pub fn build(mesh: &TriangleMesh) -> Self {
+        Self::build_with(mesh.len(), |i| mesh.triangle(i).vertices, TriangleBvhOptions::default())
+    }
+
+    /// Builds the structure over a triangle soup (triangle `i` is `triangles[i]`).
+    pub fn from_triangles(triangles: &[[Vec3; 3]]) -> Self {
+        Self::build_with(triangles.len(), |i| triangles[i as usize], TriangleBvhOptions::default())
+    }
+
+    /// Builds the structure over `count` triangles, triangle `i` given by `triangle(i)`, at most
+    /// [`MAX_PRIMITIVES`] of them. Zero-area triangles are left out (they are never hit), and so
+    /// are triangles with non-finite coordinates.
+    pub fn build_with(count: usize, triangle: impl Fn(u32) -> [Vec3; 3] + Sync, options: TriangleBvhOptions) -> Self {
+        let count = count.min(MAX_PRIMITIVES);
+        let mut boxes = vec![Aabb::EMPTY; count];
+        fill_indexed(&mut boxes, 1 << 14, |i| {
+            let v = triangle(i as u32);
+            if v.iter().all(|p| p.is_finite()) && is_storable(&v) { Aabb::from_points(v) } else { Aabb::EMPTY }
+        });
+        let ids: Vec<u32> = (0..count as u32).filter(|&i| boxes[i as usize].is_finite()).collect();
+        let kept: Vec<Aabb> = if ids.len() == count { boxes } else { ids.iter().map(|&i| boxes[i as usize]).collect() };
+        let bvh = options.builder.build(&kept);
+        let mut sink = Blocks { triangle: &triangle, ids: &ids, blocks: Vec::new(), scratch: Vec::new() };
+        let layout = convert(&bvh, ConvertOptions { collapse: options.collapse }, &mut sink);
+        TriangleBvh {
+            nodes: layout.nodes,
+            blocks: sink.blocks,
+            depth: layout.depth,
+            bounds: bvh.bounds(),
+            stored: ids.len(),
+            isa: Isa::best(),
+        }
+    }
+
+    /// The instruction set queries run with.
+    pub fn isa(&self) -> Isa {
+        self.isa
+    }
+
+    /// Runs queries with `isa` from now on, if the processor has it (for tests and measurements:
+    /// every instruction set gives the same answers).
+    pub fn set_isa(&mut self, isa: Isa) -> Result<(), IsaUnavailable> {
+        if !isa.is_available() {
+            return Err(IsaUnavailable(isa));
+        }
+        self.isa = isa;
+        Ok(())
+    }
+
+    /// The box around every stored triangle.
+    pub fn bounds(&self) -> Aabb {
+        self.bounds
+    }
+
+    /// The nodes (the root is node 0).
+    pub fn nodes(&self) -> &[WideNode] {
+        &self.nodes
+    }
+
+    /// The triangle blocks, leaf after leaf.
+    pub fn blocks(&self) -> &[TriBlock] {
+        &self.blocks
+    }
+
+    /// Wide nodes on the longest path from the root to a leaf.
+    pub fn depth(&self) -> u32 {
+        self.depth
+    }
+
+    /// The closest triangle hit within the ray's interval: `t`, the triangle's index and the
+    /// barycentric weights `(u, v)` of its second and third vertices. Of two triangles hit at
+    /// the same `t`, the lower index wins.
+    #[inline]
+    pub fn closest_hit<C: Counters>(&self, ray: &Ray, counters: &mut C) -> Option<Hit> {
+        if !ray.is_valid() || self.nodes.is_empty() {
+            return None;
+        }
+        let mut leaves = TriangleLeaves { blocks: &self.blocks, ray: TriRay::new(ray), best: None, t_max: ray.t_max };
+        dispatch::closest(self.isa, &self.nodes, self.depth, &NodeRay::new(ray), &mut leaves, counters);
+        leaves.best
+    }
+
+    /// Whether any triangle is hit within the ray's interval (shadow rays).
+    #[inline]
+    pub fn any_hit<C: Counters>(&self, ray: &Ray, counters: &mut C) -> bool {
+        if !ray.is_valid() || self.nodes.is_empty() {
+            return false;
+        }
+        let mut leaves = TriangleLeaves { blocks: &self.blocks, ray: TriRay::new(ray), best: None, t_max: ray.t_max };
+        dispatch::any(self.isa, &self.nodes, self.depth, &NodeRay::new(ray), reach(ray.t_max), &mut leaves, counters)
+    }
+
+    /// Size and shape: wide nodes, leaves, depth, stored triangles and bytes. The leaf sizes count
+    /// triangles per leaf.
+    pub fn stats(&self) -> StructureStats {
+        let mut leaf_sizes = [0; LEAF_SIZE_BUCKETS];
+        let mut leaves = 0;
+        for node in &self.nodes {
+            for slot in 0..super::node::WIDTH {
+                let c = node.children[slot];
+                if c != super::node::EMPTY && super::node::is_leaf(c) {
+                    let first = super::node::index_of(c) as usize;
+                    let tris: u32 =
+                        self.blocks[first..first + node.counts[slot] as usize].iter().map(TriBlock::used).sum();
+                    leaf_sizes[(tris as usize).clamp(1, LEAF_SIZE_BUCKETS) - 1] += 1;
+                    leaves += 1;
+                }
+            }
+        }
+        StructureStats {
+            nodes: self.nodes.len(),
+            leaves,
+            depth: self.depth as usize,
+            prim_refs: self.stored,
+            memory_bytes: std::mem::size_of::<Self>()
+                + std::mem::size_of_val(self.nodes.as_slice())
+                + std::mem::size_of_val(self.blocks.as_slice()),
+            sah_cost: None,
+            leaf_sizes,
+        }
+    }
+}
+
+/// A query's view of the triangle blocks, and its closest hit so far.
+struct TriangleLeaves<'a> {
+    blocks: &'a [TriBlock],
+    ray: TriRay,
+    best: Option<Hit>,
+    t_max: f32,
+}
+
+impl TriangleLeaves<'_> {
+    /// Keeps the hit on triangle `prim` if it is closer, or as close with a lower index (the rule
+    /// of [`crate::accel::HitRecord::offer`]).
+    #[inline(always)]
+    fn offer(&mut self, prim: u32, t: f32, u: f32, v: f32) {
+        let better = match self.best {
+            None => true,
+            Some(b) => t < b.t || (t == b.t && prim < b.prim),
+        };
+        if better {
+            self.best = Some(Hit { t, prim, u, v });
+            self.t_max = t;
+        }
+    }
+}
+
+impl<C: Counters> Leaves<C> for TriangleLeaves<'_> {
+    #[inline(always)]
+    fn closest(&mut self, first: u32, count: u32, counters: &mut C) {
+        for block in &self.blocks[first as usize..(first + count) as usize] {
+            for _ in 0..block.used() {
+                counters.exact_test();
+            }
+            let hits = intersect_block(block, &self.ray, self.t_max);
+            if hits.hit | hits.special == 0 {
+                continue;
+            }
+            let mut mask = hits.hit;
+            while mask != 0 {
+                let lane = mask.trailing_zeros() as usize;
+                mask &= mask - 1;
+                if block.ids[lane] != UNUSED {
+                    self.offer(block.ids[lane], hits.t[lane], hits.u[lane], hits.v[lane]);
+                }
+            }
+            let mut mask = hits.special;
+            while mask != 0 {
+                let lane = mask.trailing_zeros() as usize;
+                mask &= mask - 1;
+                if block.ids[lane] != UNUSED
+                    && let Some(h) = self.ray.scalar(block, lane, self.t_max)
+                {
+                    self.offer(block.ids[lane], h.t, h.u, h.v);
+                }
+            }
+        }
+    }
+
+    #[inline(always)]
+    fn t_max(&self) -> f32 {
+        self.t_max
+    }
+
+    #[inline(always)]
+    fn prefetch(&self, first: u32) {
+        #[cfg(target_arch = "x86_64")]
+        if let Some(block) = self.blocks.get(first as usize) {
+            let p = block as *const TriBlock as *const i8;
+            // SAFETY: prefetching is a hint that never faults; the addresses are inside the block.
+            unsafe {
+                use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
+                for line in 0..3 {
+                    _mm_prefetch::<_MM_HINT_T0>(p.add(64 * line).min(p.add(159)));
+                }
+            }
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        let _ = first;
+    }
+
+    #[inline(always)]
+    fn any(&mut self, first: u32, count: u32, counters: &mut C) -> bool {
+        for block in &self.blocks[first as usize..(first + count) as usize] {
+            for _ in 0..block.used() {
+                counters.exact_test();
+            }
+            let hits = intersect_block(block, &self.ray, self.t_max);
+            // An unused lane repeats a used one: its hit is that lane's.
+            if hits.hit != 0 {
+                return true;
+            }
+            let mut mask = hits.special;
+            while mask != 0 {
+                let lane = mask.trailing_zeros() as usize;
+                mask &= mask - 1;
+                if self.ray.scalar(block, lane, self.t_max).is_some() {
+                    return true;
+                }
+            }
+        }
+        false
+    }
+}

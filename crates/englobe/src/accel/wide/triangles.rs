@@ -1,0 +1,321 @@
+//! Triangles stored for SIMD intersection: blocks of four, vertices as a structure of arrays, and
+//! the watertight test of Woop, Benthin and Wald (2013), "Watertight Ray/Triangle Intersection"
+//! (JCGT 2(1)) run on the four at once.
+//!
+//! The block layout is Embree's `Triangle4` (Wald et al. 2014, "Embree: A Kernel Framework for
+//! Efficient CPU Ray Tracing"), with the three vertices kept as they are rather than as edges, because the
+//! watertight test shears the vertices themselves. A ray's axes `kx, ky, kz` only choose which
+//! rows of the block are read, so no data moves per ray.
+//!
+//! The lanes compute exactly what the scalar test [`intersect_triangle`] computes, with the same
+//! operations in the same order (no fused multiply-add), so a lane hits if and only if the scalar
+//! test hits, at the same `t`. The scalar test's rare paths are not duplicated: a lane whose edge
+//! functions are not all normal numbers (zero, subnormal, infinite: a ray through an edge or a
+//! vertex, or a scene at an extreme scale) or whose `t` is not finite is reported as *special*,
+//! and the caller runs the scalar test on that triangle. Lanes whose edge functions have strictly
+//! opposite signs are misses whatever the precision (rounding is monotonic, so a nonzero `f32`
+//! edge function has the sign of the exact one), which the scalar test's `f64` path would also
+//! conclude. Zero-area triangles are never stored: the scalar test never hits them.
+
+use glam::{BVec4A, Vec3, Vec4};
+
+use crate::Ray;
+use crate::aabb::ROBUST_FAR_SCALE;
+use crate::shapes::{PrimHit, WatertightRay, intersect_triangle, is_degenerate};
+
+/// Triangles per block.
+pub const LANES: usize = 4;
+
+/// The triangle index of a block's unused lanes (they repeat a used lane's vertices).
+pub const UNUSED: u32 = u32::MAX;
+
+/// Four triangles: row `3 * vertex + axis` holds that coordinate of that vertex for each lane.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C, align(16))]
+pub struct TriBlock {
+    /// The vertices' coordinates, one row per coordinate, one column per lane.
+    pub v: [[f32; LANES]; 9],
+    /// Each lane's triangle index in the mesh, or [`UNUSED`].
+    pub ids: [u32; LANES],
+}
+
+const _: () = assert!(std::mem::size_of::<TriBlock>() == 160);
+
+impl TriBlock {
+    /// A block over up to four triangles (at least one); unused lanes repeat the first.
+    pub fn new(triangles: &[(u32, [Vec3; 3])]) -> Self {
+        assert!((1..=LANES).contains(&triangles.len()), "a block holds 1 to {LANES} triangles");
+        let mut block = TriBlock { v: [[0.0; LANES]; 9], ids: [UNUSED; LANES] };
+        for lane in 0..LANES {
+            let (id, verts) = triangles.get(lane).copied().unwrap_or((UNUSED, triangles[0].1));
+            block.ids[lane] = id;
+            for (k, p) in verts.iter().enumerate() {
+                for axis in 0..3 {
+                    block.v[3 * k + axis][lane] = p[axis];
+                }
+            }
+        }
+        block
+    }
+
+    /// The vertices of lane `lane`.
+    #[inline(always)]
+    pub fn vertices(&self, lane: usize) -> [Vec3; 3] {
+        let v = &self.v;
+        [0, 1, 2].map(|k| Vec3::new(v[3 * k][lane], v[3 * k + 1][lane], v[3 * k + 2][lane]))
+    }
+
+    /// Number of used lanes.
+    #[inline(always)]
+    pub fn used(&self) -> u32 {
+        self.ids.iter().filter(|&&id| id != UNUSED).count() as u32
+    }
+}
+
+/// Whether the triangle can ever be hit (it has an area): the rule of the scalar test.
+pub fn is_storable(v: &[Vec3; 3]) -> bool {
+    !is_degenerate(v[0], v[1], v[2])
+}
+
+/// A ray prepared for block tests: the watertight test's constants, and what the box-stretch
+/// correction of a hit needs.
+#[derive(Clone, Copy, Debug)]
+pub struct TriRay {
+    /// The ray itself, for the scalar test of special lanes.
+    pub ray: Ray,
+    /// Its watertight constants, for the same.
+    pub watertight: WatertightRay,
+    origin: [Vec4; 3],
+    inv_dir: [Vec4; 3],
+    axes: [usize; 3],
+    shear: [Vec4; 3],
+    t_min: Vec4,
+}
+
+impl TriRay {
+    /// Prepares `ray`.
+    #[inline(always)]
+    pub fn new(ray: &Ray) -> Self {
+        let watertight = WatertightRay::new(ray);
+        let (o, inv, s) = (ray.origin(), ray.inv_dir(), watertight.shear());
+        TriRay {
+            ray: *ray,
+            watertight,
+            origin: [0, 1, 2].map(|a| Vec4::splat(o[a])),
+            inv_dir: [0, 1, 2].map(|a| Vec4::splat(inv[a])),
+            axes: watertight.axes(),
+            shear: [0, 1, 2].map(|a| Vec4::splat(s[a])),
+            t_min: Vec4::splat(ray.t_min),
+        }
+    }
+
+    /// The scalar test of lane `lane` with the interval `t_min..=t_max`: for special lanes.
+    #[inline(never)]
+    #[cold]
+    pub fn scalar(&self, block: &TriBlock, lane: usize, t_max: f32) -> Option<PrimHit> {
+        let [a, b, c] = block.vertices(lane);
+        intersect_triangle(&self.ray.with_range(self.ray.t_min, t_max), &self.watertight, a, b, c)
+    }
+}
+
+/// What the four lanes of a block gave.
+#[derive(Clone, Copy, Debug)]
+pub struct BlockHits {
+    /// Lanes hit within the interval (bit per lane).
+    pub hit: u32,
+    /// Lanes the scalar test must decide.
+    pub special: u32,
+    /// Hit distance of each hit lane.
+    pub t: [f32; LANES],
+    /// First barycentric of each hit lane.
+    pub u: [f32; LANES],
+    /// Second barycentric of each hit lane.
+    pub v: [f32; LANES],
+}
+
+impl BlockHits {
+    /// No lane hit and none special.
+    pub const NONE: BlockHits = BlockHits { hit: 0, special: 0, t: [0.0; 4], u: [0.0; 4], v: [0.0; 4] };
+}
+
+/// `if a > b { a } else { b }` per lane, as the scalar slab test: `b` when `a` is NaN.
+#[inline(always)]
+fn keep_greater(a: Vec4, b: Vec4) -> Vec4 {
+    Vec4::select(a.cmpgt(b), a, b)
+}
+
+/// `if a < b { a } else { b }` per lane.
+#[inline(always)]
+fn keep_less(a: Vec4, b: Vec4) -> Vec4 {
+    Vec4::select(a.cmplt(b), a, b)
+}
+
+/// Lanes holding normal numbers (not zero, subnormal, infinite or NaN), as `f32::is_normal`.
+#[inline(always)]
+fn normal(x: Vec4) -> BVec4A {
+    let a = x.abs();
+    a.cmpge(Vec4::splat(f32::MIN_POSITIVE)) & a.cmplt(Vec4::INFINITY)
+}
+
+/// The watertight test of the ray against the four triangles of `block`, within
+/// `t_min..=t_max`. Every lane reports what [`intersect_triangle`] would, or is special.
+#[inline(always)]
+pub fn intersect_block(block: &TriBlock, r: &TriRay, t_max: f32) -> BlockHits {
+    let [kx, ky, kz] = r.axes;
+    let row = |k: usize, axis: usize| Vec4::from_array(block.v[3 * k + axis]);
+    let [sx, sy, sz] = r.shear;
+    // Vertex k relative to the origin, sheared: exactly the scalar test's `ax`, `ay`, `az`.
+    let project = |k: usize| {
+        let (x, y, z) = (row(k, kx) - r.origin[kx], row(k, ky) - r.origin[ky], row(k, kz) - r.origin[kz]);
+        (x - sx * z, y - sy * z, z)
+    };
+    let (ax, ay, a_z) = project(0);
+    let (bx, by, b_z) = project(1);
+    let (cx, cy, c_z) = project(2);
+    let e0 = cx * by - cy * bx;
+    let e1 = ax * cy - ay * cx;
+    let e2 = bx * ay - by * ax;
+    let zero = Vec4::ZERO;
+    let negative = e0.cmplt(zero) | e1.cmplt(zero) | e2.cmplt(zero);
+    let positive = e0.cmpgt(zero) | e1.cmpgt(zero) | e2.cmpgt(zero);
+    let inside = !(negative & positive);
+    if !inside.any() {
+        return BlockHits::NONE;
+    }
+    let all_normal = normal(e0) & normal(e1) & normal(e2);
+    let special = inside & !all_normal;
+    let candidate = inside & all_normal;
+    if !candidate.any() {
+        return BlockHits { special: special.bitmask(), ..BlockHits::NONE };
+    }
+    let (az, bz, cz) = (sz * a_z, sz * b_z, sz * c_z);
+    let det = e0 + e1 + e2;
+    let t_scaled = e0 * az + e1 * bz + e2 * cz;
+    let inv_det = Vec4::ONE / det;
+    let t = t_scaled * inv_det;
+    let finite = t.abs().cmplt(Vec4::INFINITY);
+    let special = special | (candidate & !finite);
+    let candidate = candidate & finite;
+
+    // The box-stretch correction of the scalar test's `finish`: the stretch of the whole line
+    // inside the triangle's box, computed as the robust slab test computes it.
+    let (mut enter, mut exit) = (Vec4::NEG_INFINITY, Vec4::INFINITY);
+    for axis in 0..3 {
+        let (p, q, s) = (row(0, axis), row(1, axis), row(2, axis));
+        let (lo, hi) = (p.min(q).min(s), p.max(q).max(s));
+        let inv = r.inv_dir[axis];
+        let positive_dir = inv.cmpge(zero);
+        let near = Vec4::select(positive_dir, lo, hi);
+        let far = Vec4::select(positive_dir, hi, lo);
+        let t_near = (near - r.origin[axis]) * inv;
+        let t_far = (far - r.origin[axis]) * inv * ROBUST_FAR_SCALE;
+        enter = keep_greater(t_near, enter);
+        exit = keep_less(t_far, exit);
+    }
+    let in_box = enter.cmple(exit);
+    let t = Vec4::select(t.cmplt(enter), enter, t);
+    let t = Vec4::select(t.cmpgt(exit), exit, t);
+    let in_range = t.cmpge(r.t_min) & t.cmple(Vec4::splat(t_max));
+    let hit = candidate & in_box & in_range;
+    BlockHits {
+        hit: hit.bitmask(),
+        special: special.bitmask(),
+        t: t.to_array(),
+        u: (e1 * inv_det).to_array(),
+        v: (e2 * inv_det).to_array(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// xorshift32, so that failures reproduce.
+    fn rng(mut s: u32) -> impl FnMut() -> f32 {
+        move || {
+            s ^= s << 13;
+            s ^= s >> 17;
+            s ^= s << 5;
+            (s >> 8) as f32 / (1 << 24) as f32
+        }
+    }
+
+    /// The lanes against the scalar test, lane by lane, special lanes resolved by it.
+    fn agree(tris: &[(u32, [Vec3; 3])], ray: &Ray) -> u32 {
+        let block = TriBlock::new(tris);
+        let r = TriRay::new(ray);
+        let w = WatertightRay::new(ray);
+        let got = intersect_block(&block, &r, ray.t_max);
+        let mut hits = 0;
+        for (lane, (_, [a, b, c])) in tris.iter().enumerate() {
+            let expected = intersect_triangle(ray, &w, *a, *b, *c);
+            let lane_hit = if got.special >> lane & 1 != 0 {
+                r.scalar(&block, lane, ray.t_max)
+            } else if got.hit >> lane & 1 != 0 {
+                Some(PrimHit { t: got.t[lane], u: got.u[lane], v: got.v[lane] })
+            } else {
+                None
+            };
+            assert_eq!(lane_hit, expected, "lane {lane} of {tris:?}, {ray:?}");
+            hits += lane_hit.is_some() as u32;
+        }
+        hits
+    }
+
+    #[test]
+    fn lanes_agree_with_the_scalar_test_on_random_triangles() {
+        let mut next = rng(0x9e37_79b9);
+        let mut hits = 0;
+        for i in 0..20_000 {
+            let mut p = || Vec3::new(next(), next(), next()) * 2.0 - 1.0;
+            let tris: Vec<(u32, [Vec3; 3])> = (0..1 + i % 4).map(|k| (k as u32, [p(), p(), p()])).collect();
+            let origin = p() * 3.0;
+            let target = p() * 0.5;
+            let t_max = [f32::INFINITY, 2.0, 0.5][i % 3];
+            hits += agree(&tris, &Ray::segment(origin, target - origin, 0.0, t_max));
+        }
+        assert!(hits > 1000, "{hits}");
+    }
+
+    #[test]
+    fn lanes_agree_on_edges_vertices_and_axis_parallel_rays() {
+        // A fan of triangles on an integer grid, with rays through its vertices and edges along
+        // the axes and diagonals: edge functions of exactly zero, the scalar test's f64 path.
+        let grid = |x: f32, y: f32| Vec3::new(x, y, 0.0);
+        let tris = [
+            (0, [grid(0.0, 0.0), grid(1.0, 0.0), grid(1.0, 1.0)]),
+            (1, [grid(0.0, 0.0), grid(1.0, 1.0), grid(0.0, 1.0)]),
+            (2, [grid(1.0, 0.0), grid(2.0, 0.0), grid(1.0, 1.0)]),
+            (3, [grid(0.0, 1.0), grid(1.0, 1.0), grid(0.0, 2.0)]),
+        ];
+        let mut hits = 0;
+        for i in 0..=8 {
+            for j in 0..=8 {
+                let o = Vec3::new(i as f32 * 0.25, j as f32 * 0.25, 2.0);
+                for d in [-Vec3::Z, Vec3::new(0.0, -0.0, -1.0), Vec3::new(0.25, 0.25, -1.0), Vec3::new(-0.5, 0.0, -1.0)]
+                {
+                    hits += agree(&tris, &Ray::new(o, d));
+                }
+            }
+        }
+        assert!(hits > 100, "{hits}");
+        // Rays in the triangles' plane, and scenes scaled to the limits of f32.
+        for s in [1e-30f32, 1e-20, 1.0, 1e20, 1e30] {
+            let scaled: Vec<(u32, [Vec3; 3])> = tris.iter().map(|(i, v)| (*i, v.map(|p| p * s))).collect();
+            agree(&scaled, &Ray::new(Vec3::new(0.25, 0.5, -1.0) * s, Vec3::Z));
+            agree(&scaled, &Ray::new(Vec3::new(-1.0, 0.25, 0.0) * s, Vec3::X));
+        }
+    }
+
+    #[test]
+    fn unused_lanes_repeat_the_first_triangle() {
+        let t = (7, [Vec3::ZERO, Vec3::X, Vec3::Y]);
+        let block = TriBlock::new(&[t]);
+        assert_eq!(block.ids, [7, UNUSED, UNUSED, UNUSED]);
+        assert_eq!(block.used(), 1);
+        assert_eq!(block.vertices(3), t.1);
+        let hits = intersect_block(&block, &TriRay::new(&Ray::new(Vec3::new(0.2, 0.2, 1.0), -Vec3::Z)), 10.0);
+        assert_eq!(hits.hit, 0b1111);
+        assert!(!is_storable(&[Vec3::ZERO, Vec3::X, Vec3::X * 2.0]) && is_storable(&t.1));
+    }
+}

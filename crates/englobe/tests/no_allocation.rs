@@ -1,0 +1,108 @@
+//! Queries of the wide BVHs allocate nothing: a counting global allocator watches thousands of
+//! closest-hit and any-hit queries (with counting off, the zero-sized `NoCount`, and on). Trees
+//! deeper than the inline stack grow a per-thread buffer on their first query, and never again.
+//! One test per binary, so that no other test's allocations are counted.
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use englobe::accel::bvh::layout::{BuildKind, BuildNode, BuildTree};
+use englobe::accel::wide::traverse::INLINE_DEPTH;
+use englobe::{Aabb, Accel, NoCount, PrimHit, Ray, TriangleBvh, Vec3, WideBvh, WorkCounts};
+
+struct Counting;
+
+static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
+
+// SAFETY: forwards to the system allocator, only counting calls.
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        // SAFETY: the caller's guarantees, passed on.
+        unsafe { System.alloc(layout) }
+    }
+
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        // SAFETY: as above.
+        unsafe { System.dealloc(ptr, layout) }
+    }
+
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        // SAFETY: as above.
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+fn allocations_during(f: impl FnOnce()) -> usize {
+    let before = ALLOCATIONS.load(Ordering::SeqCst);
+    f();
+    ALLOCATIONS.load(Ordering::SeqCst) - before
+}
+
+#[test]
+fn queries_never_allocate() {
+    // A grid of small triangles, and rays across it.
+    let mut tris = Vec::new();
+    for i in 0..60 {
+        for j in 0..60 {
+            let o = Vec3::new(i as f32, j as f32, ((i * 7 + j * 3) % 5) as f32);
+            tris.push([o, o + Vec3::X, o + Vec3::Y]);
+        }
+    }
+    let rays: Vec<Ray> = (0..5000)
+        .map(|k| {
+            let f = k as f32;
+            Ray::new(
+                Vec3::new((f * 0.37) % 60.0, (f * 0.61) % 60.0, 10.0),
+                Vec3::new((f * 0.1).sin(), (f * 0.2).cos(), -1.0),
+            )
+        })
+        .collect();
+    let tri_bvh = TriangleBvh::from_triangles(&tris);
+    let boxes: Vec<Aabb> = tris.iter().map(|t| Aabb::from_points(*t)).collect();
+    let wide = WideBvh::build(&boxes);
+    let test = |i: u32, r: &Ray| boxes[i as usize].intersect(r).map(|(t, _)| PrimHit::at(t));
+
+    let mut hits = 0;
+    let n = allocations_during(|| {
+        for r in &rays {
+            hits += tri_bvh.closest_hit(r, &mut NoCount).is_some() as usize;
+            hits += tri_bvh.any_hit(r, &mut NoCount) as usize;
+            hits += tri_bvh.closest_hit(r, &mut WorkCounts::default()).is_some() as usize;
+            hits += wide.closest_hit(r, &mut NoCount, test).is_some() as usize;
+            hits += wide.any_hit(r, &mut NoCount, |i, r| test(i, r).is_some()) as usize;
+        }
+    });
+    assert_eq!(n, 0, "{n} allocations in {} queries", 5 * rays.len());
+    assert!(hits > rays.len(), "{hits}");
+
+    // A tree deeper than the inline stack (a chain: node k holds box k and node k + 1): one
+    // buffer per thread, grown on the first query.
+    let n = 600u32;
+    let boxes: Vec<Aabb> =
+        (0..n).map(|i| Aabb::new(Vec3::new(i as f32, 0.0, 0.0), Vec3::new(i as f32 + 0.5, 1.0, 1.0))).collect();
+    let mut nodes: Vec<BuildNode> = (0..n as usize)
+        .map(|i| BuildNode { bounds: boxes[i], kind: BuildKind::Leaf { first: i as u32, count: 1 } })
+        .collect();
+    for i in 0..n - 1 {
+        let bounds = Aabb::new(Vec3::new(i as f32, 0.0, 0.0), Vec3::new(n as f32, 1.0, 1.0));
+        let next = if i + 1 == n - 1 { n - 1 } else { n + i + 1 };
+        nodes.push(BuildNode { bounds, kind: BuildKind::Interior { children: [i, next] } });
+    }
+    let deep = WideBvh::from_bvh(&BuildTree { nodes, prims: (0..n).collect(), root: n }.into_bvh());
+    assert!(deep.depth() as usize > INLINE_DEPTH, "depth {}", deep.depth());
+    let test = |i: u32, r: &Ray| boxes[i as usize].intersect(r).map(|(t, _)| PrimHit::at(t));
+    let ray = Ray::new(Vec3::new(1000.0, 0.5, 0.5), -Vec3::X);
+    assert_eq!(deep.closest_hit(&ray, &mut NoCount, test).map(|h| h.prim), Some(n - 1));
+    let allocated = allocations_during(|| {
+        for _ in 0..100 {
+            deep.closest_hit(&ray, &mut NoCount, test);
+            deep.any_hit(&ray, &mut NoCount, |i, r| test(i, r).is_some());
+        }
+    });
+    assert_eq!(allocated, 0, "{allocated} allocations on a tree of depth {}", deep.depth());
+}

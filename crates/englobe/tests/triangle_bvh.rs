@@ -1,0 +1,259 @@
+//! [`TriangleBvh`], the triangle fast path, against brute force with the scalar watertight test
+//! (Woop, Benthin and Wald 2013): the same closest hit (triangle, `t`, barycentrics, bit for bit)
+//! and the same any-hit answer, in every instruction set the processor has, with counting on and
+//! off. Random soups with degenerate triangles, axis-parallel rays through shared vertices and
+//! edges, ties between copies, deep trees, and the Stanford bunny.
+
+mod common;
+
+use common::load_obj;
+use englobe::accel::wide::Isa;
+use englobe::shapes::{WatertightRay, intersect_triangle};
+use englobe::{Hit, NoCount, Ray, TriangleBvh, Vec3, WorkCounts};
+use proptest::prelude::*;
+
+/// The closest hit by testing every triangle, ties to the lower index, and the any-hit answer.
+fn brute(tris: &[[Vec3; 3]], ray: &Ray) -> (Option<Hit>, bool) {
+    let w = WatertightRay::new(ray);
+    let mut best: Option<Hit> = None;
+    let mut any = false;
+    for (i, [a, b, c]) in tris.iter().enumerate() {
+        let t_max = best.map_or(ray.t_max, |h| h.t);
+        if let Some(h) = intersect_triangle(&ray.with_range(ray.t_min, t_max), &w, *a, *b, *c) {
+            any = true;
+            if best.is_none_or(|b| h.t < b.t) {
+                best = Some(Hit { t: h.t, prim: i as u32, u: h.u, v: h.v });
+            }
+        }
+    }
+    (best, any)
+}
+
+/// Checks `bvh` in every available instruction set against brute force on every ray; returns the
+/// number of rays that hit.
+fn check(tris: &[[Vec3; 3]], rays: &[Ray]) -> Result<usize, String> {
+    let mut bvh = TriangleBvh::from_triangles(tris);
+    let expected: Vec<(Option<Hit>, bool)> = rays.iter().map(|r| brute(tris, r)).collect();
+    for isa in Isa::available() {
+        bvh.set_isa(isa).map_err(|e| e.to_string())?;
+        for (ray, &(closest, any)) in rays.iter().zip(&expected) {
+            let got = bvh.closest_hit(ray, &mut NoCount);
+            if got != closest {
+                return Err(format!("{isa}: closest hit of {ray:?}: brute force {closest:?}, TriangleBvh {got:?}"));
+            }
+            let counted = bvh.closest_hit(ray, &mut WorkCounts::default());
+            if counted != got {
+                return Err(format!("{isa}: counting changed the closest hit of {ray:?}"));
+            }
+            let got_any = bvh.any_hit(ray, &mut NoCount);
+            if got_any != any {
+                return Err(format!("{isa}: any hit of {ray:?}: brute force {any}, TriangleBvh {got_any}"));
+            }
+        }
+    }
+    Ok(expected.iter().filter(|e| e.0.is_some()).count())
+}
+
+fn coord() -> impl Strategy<Value = f32> {
+    prop_oneof![3 => -4.0f32..4.0, 1 => (-4i32..=4).prop_map(|i| i as f32)]
+}
+
+fn point() -> impl Strategy<Value = Vec3> {
+    (coord(), coord(), coord()).prop_map(|(x, y, z)| Vec3::new(x, y, z))
+}
+
+/// Small triangles, and degenerate ones: a repeated vertex, or three points on a line.
+fn triangle() -> impl Strategy<Value = [Vec3; 3]> {
+    prop_oneof![
+        8 => (point(), point(), point()).prop_map(|(a, b, c)| [a, a + (b - a) * 0.4, a + (c - a) * 0.4]),
+        1 => (point(), point()).prop_map(|(a, b)| [a, b, a]),
+        1 => (point(), point()).prop_map(|(a, b)| [a, b, a + (b - a) * 2.0]),
+    ]
+}
+
+/// Directions: random, or along an axis with zeros of either sign.
+fn direction() -> impl Strategy<Value = Vec3> {
+    let axis = (0usize..3, prop::bool::ANY, prop::bool::ANY).prop_map(|(axis, negative, negative_zeros)| {
+        let mut d = Vec3::splat(if negative_zeros { -0.0 } else { 0.0 });
+        d[axis] = if negative { -1.0 } else { 1.0 };
+        d
+    });
+    prop_oneof![2 => point(), 1 => axis].prop_filter("a direction", |d| *d != Vec3::ZERO)
+}
+
+/// Origin, direction, a vertex to aim at instead (triangle, vertex), `t_min`, `t_max`.
+type RaySpec = (Vec3, Vec3, Option<(usize, usize)>, f32, f32);
+
+/// Rays from anywhere, or aimed exactly at a vertex of one of the triangles, over the whole line
+/// or a segment.
+fn rays(tris: &[[Vec3; 3]], specs: &[RaySpec]) -> Vec<Ray> {
+    specs
+        .iter()
+        .map(|&(o, d, aim, t0, t1)| {
+            let d = match aim {
+                Some((i, k)) if tris[i % tris.len()][k % 3] != o => tris[i % tris.len()][k % 3] - o,
+                _ => d,
+            };
+            Ray::segment(o * 1.5, d, t0, t1)
+        })
+        .collect()
+}
+
+fn ray_spec() -> impl Strategy<Value = RaySpec> {
+    let range =
+        prop_oneof![3 => Just((0.0f32, f32::INFINITY)), 1 => (0.0f32..3.0, 0.0f32..6.0).prop_map(|(a, b)| (a, a + b))];
+    (point(), direction(), prop::option::of((0usize..1000, 0usize..3)), range)
+        .prop_map(|(o, d, aim, (t0, t1))| (o, d, aim, t0, t1))
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    #[test]
+    fn random_soups_agree_with_brute_force(
+        tris in prop::collection::vec(triangle(), 1..300),
+        specs in prop::collection::vec(ray_spec(), 1..60),
+    ) {
+        let rays = rays(&tris, &specs);
+        check(&tris, &rays).map_err(TestCaseError::fail)?;
+    }
+}
+
+#[test]
+fn axis_parallel_rays_through_shared_vertices_and_edges() {
+    // A folded grid of triangles sharing edges and vertices, with integer coordinates: rays along
+    // the axes through vertices and edges hit exactly on them.
+    let n = 12;
+    let p = |i: usize, j: usize| Vec3::new(i as f32, j as f32, ((i + j) % 3) as f32 * 0.5);
+    let mut tris = Vec::new();
+    for i in 0..n {
+        for j in 0..n {
+            tris.push([p(i, j), p(i + 1, j), p(i + 1, j + 1)]);
+            tris.push([p(i, j), p(i + 1, j + 1), p(i, j + 1)]);
+        }
+    }
+    let mut rays = Vec::new();
+    for i in 0..=2 * n {
+        for j in 0..=2 * n {
+            let (x, y) = (i as f32 * 0.5, j as f32 * 0.5);
+            for (o, d) in [
+                (Vec3::new(x, y, 5.0), Vec3::new(0.0, -0.0, -1.0)),
+                (Vec3::new(x, y, -5.0), Vec3::Z),
+                (Vec3::new(-1.0, y, x * 0.1), Vec3::X),
+                (Vec3::new(x, n as f32 + 1.0, 0.5), -Vec3::Y),
+            ] {
+                rays.push(Ray::new(o, d));
+            }
+        }
+    }
+    let hits = check(&tris, &rays).unwrap();
+    // Watertight: every vertical ray inside the grid's footprint hits.
+    let vertical = rays.iter().filter(|r| r.dir().x == 0.0 && r.dir().y == 0.0).count();
+    assert!(hits >= vertical, "{hits} hits, {vertical} vertical rays");
+}
+
+#[test]
+fn degenerate_triangles_are_never_hit_and_never_stored() {
+    let tris = vec![
+        [Vec3::ZERO, Vec3::X, Vec3::X * 2.0],
+        [Vec3::Y, Vec3::Y, Vec3::Z],
+        [Vec3::ZERO, Vec3::X, Vec3::Y],
+        [Vec3::splat(f32::NAN), Vec3::X, Vec3::Y],
+        [Vec3::ONE; 3],
+    ];
+    let bvh = TriangleBvh::from_triangles(&tris);
+    assert_eq!(bvh.stats().prim_refs, 1);
+    let rays: Vec<Ray> =
+        [Vec3::new(0.5, 0.0, 1.0), Vec3::new(0.2, 0.2, 1.0), Vec3::new(0.0, 1.0, 0.5), Vec3::ONE + Vec3::Z]
+            .into_iter()
+            .flat_map(|o| {
+                [Ray::new(o, -Vec3::Z), Ray::new(o - Vec3::Y * 2.0, Vec3::Y), Ray::new(o + Vec3::X, -Vec3::X)]
+            })
+            .collect();
+    assert!(check(&tris, &rays).unwrap() > 0);
+    for r in &rays {
+        assert!(bvh.closest_hit(r, &mut NoCount).is_none_or(|h| h.prim == 2), "{r:?}");
+    }
+    let none = [[Vec3::ZERO, Vec3::X, Vec3::X]; 10];
+    let empty = TriangleBvh::from_triangles(&none);
+    assert_eq!(empty.stats().prim_refs, 0);
+    assert_eq!(check(&none, &rays).unwrap(), 0);
+    assert_eq!(check(&[], &rays).unwrap(), 0);
+}
+
+#[test]
+fn copies_of_one_triangle_tie_to_the_lowest_index() {
+    let t = [Vec3::ZERO, Vec3::X, Vec3::Y];
+    let mut tris = vec![[Vec3::new(5.0, 5.0, 5.0), Vec3::new(6.0, 5.0, 5.0), Vec3::new(5.0, 6.0, 5.0)]; 3];
+    tris.extend(std::iter::repeat_n(t, 40));
+    let ray = Ray::new(Vec3::new(0.25, 0.25, 1.0), -Vec3::Z);
+    check(&tris, &[ray]).unwrap();
+    assert_eq!(TriangleBvh::from_triangles(&tris).closest_hit(&ray, &mut NoCount).map(|h| h.prim), Some(3));
+}
+
+#[test]
+fn deep_trees_of_nested_triangles() {
+    // Nested triangles shrinking geometrically around one point: the SAH separates them a few at
+    // a time, so the tree is deep and every ray near the centre walks down all of it.
+    let tris: Vec<[Vec3; 3]> = (0..1500)
+        .map(|i| {
+            let s = 0.96f32.powi(i);
+            [Vec3::new(-s, -s, s * 0.1), Vec3::new(s, -s, s * 0.1), Vec3::new(0.0, s, s * 0.1)]
+        })
+        .collect();
+    let bvh = TriangleBvh::from_triangles(&tris);
+    let rays: Vec<Ray> = (0..200)
+        .map(|k| {
+            let x = (k as f32 * 0.37).sin() * 0.5;
+            [Ray::new(Vec3::new(x, 0.0, -1.0), Vec3::Z), Ray::new(Vec3::new(x, 0.01, 10.0), -Vec3::Z)][k % 2]
+        })
+        .collect();
+    let hits = check(&tris, &rays).unwrap();
+    assert!(hits > 100, "{hits}");
+    assert!(bvh.depth() > 16, "depth {}", bvh.depth());
+}
+
+#[test]
+fn stanford_bunny_in_every_instruction_set() {
+    let mesh = load_obj("scenes/meshes/bunny/stanford-bunny.obj");
+    let tris: Vec<[Vec3; 3]> = (0..mesh.len() as u32).map(|i| mesh.triangle(i).vertices).collect();
+    let bounds = mesh.bounds();
+    let (centre, extent) = (bounds.center(), bounds.extent());
+    let mut state = 0x9e37_79b9_7f4a_7c15u64;
+    let mut next = move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 40) as f32 / (1u64 << 24) as f32
+    };
+    let mut rays = Vec::new();
+    for _ in 0..1500 {
+        let dir = Vec3::new(next() - 0.5, next() - 0.5, next() - 0.5).normalize_or(Vec3::X);
+        let origin = centre + dir * extent.length();
+        let target = bounds.min + extent * Vec3::new(next(), next(), next());
+        rays.push(Ray::new(origin, target - origin));
+        // Rays from inside the mesh's box, in every direction (some start inside the bunny).
+        let inside = bounds.min + extent * Vec3::new(next(), next(), next());
+        rays.push(Ray::new(inside, Vec3::new(next() - 0.5, next() - 0.5, next() - 0.5)));
+    }
+    for axis in 0..3 {
+        for i in 0..10 {
+            let mut o = centre + extent * ((i as f32 + 0.5) / 10.0 - 0.5);
+            o[axis] = bounds.min[axis] - 1.0;
+            let mut d = Vec3::splat(0.0);
+            d[axis] = 1.0;
+            rays.push(Ray::new(o, d));
+        }
+    }
+    let hits = check(&tris, &rays).unwrap();
+    assert!(hits * 3 > rays.len(), "only {hits} of {} rays hit", rays.len());
+
+    // Work: a small fraction of brute force's exact tests.
+    let bvh = TriangleBvh::from_triangles(&tris);
+    let mut counts = WorkCounts::default();
+    for r in &rays {
+        bvh.closest_hit(r, &mut counts);
+    }
+    let brute_tests = (tris.len() * rays.len()) as u64;
+    assert!(counts.exact_tests * 500 < brute_tests, "{} exact tests, brute force {brute_tests}", counts.exact_tests);
+}
