@@ -8,7 +8,8 @@
 //! for some of the same rays.
 
 use englobe::aabb::ROBUST_FAR_SCALE;
-use englobe::{Aabb, AccelKind, NoCount, Ray, TriangleMesh, Vec3, World};
+use englobe::accel::Isa;
+use englobe::{Aabb, AccelKind, NoCount, Ray, TriangleBvh, TriangleMesh, Vec3, World};
 
 /// SplitMix64, so that failures reproduce.
 struct Rng(u64);
@@ -75,6 +76,19 @@ fn rays_through_a_shared_vertex_on_box_faces_hit_in_every_structure() {
     for mesh in fans() {
         let rays = rays_at_apex(&mesh, 20_000, 3);
         let brute = World::build(vec![mesh.clone().into()], AccelKind::None).unwrap();
+        for isa in Isa::available() {
+            let mut fast = TriangleBvh::build(&mesh);
+            fast.set_isa(isa).unwrap();
+            for ray in &rays {
+                let expected = brute.closest_hit(ray, &mut NoCount).map(|h| (h.t, h.prim));
+                assert_eq!(
+                    fast.closest_hit(ray, &mut NoCount).map(|h| (h.t, h.prim)),
+                    expected,
+                    "TriangleBvh ({isa}): {ray:?}"
+                );
+                assert!(fast.any_hit(ray, &mut NoCount), "TriangleBvh ({isa}): any-hit misses {ray:?}");
+            }
+        }
         for &kind in AccelKind::ALL {
             let world = World::build(vec![mesh.clone().into()], kind).unwrap();
             for ray in &rays {

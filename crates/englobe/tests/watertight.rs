@@ -11,7 +11,8 @@
 
 use std::sync::Arc;
 
-use englobe::{AccelKind, Affine3A, Instance, NoCount, Object, Ray, TriangleMesh, Vec3, World};
+use englobe::accel::Isa;
+use englobe::{AccelKind, Affine3A, Instance, NoCount, Object, Ray, TriangleBvh, TriangleMesh, Vec3, World};
 use glam::DVec3;
 use rayon::prelude::*;
 
@@ -225,12 +226,22 @@ fn rays_from_inside_an_instanced_sphere_never_miss() {
 fn every_structure_finds_the_jittered_sphere_from_inside() {
     // The same rays through the world, with every structure: a structure must not lose through
     // its boxes what the triangle test finds. A million random rays from inside and the rays at
-    // every vertex and edge midpoint, at the origin and far from it. The seed's two BVHs, whose
+    // every vertex and edge midpoint, at the origin and far from it; `TriangleBvh` in every
+    // instruction set too. The seed's two BVHs, whose
     // traversal visits thousands of nodes per ray on a mesh this size, take every 100th ray.
     for (center, radius, seed) in [(Vec3::ZERO, 1.0, 0x243F_6A88_85A3_08D3), (FAR, 100.0, 0x1319_8A2E_0370_7344)] {
         let sphere = UvSphere::new(center, radius, 128, 256, JITTER);
         let mut rays: Vec<Ray> = random_rays(&sphere, 1_000_000, seed).collect();
         rays.extend(rays_at_vertices_and_edges(&sphere));
+        for isa in Isa::available() {
+            // The triangle-mesh fast path, in every instruction set this processor has.
+            let mut fast = TriangleBvh::build(&sphere.mesh);
+            fast.set_isa(isa).unwrap();
+            let misses = rays.par_iter().filter(|ray| fast.closest_hit(ray, &mut NoCount).is_none()).count();
+            assert_eq!(misses, 0, "TriangleBvh ({isa}) at {center}: {misses} of {} rays miss", rays.len());
+            let any_misses = rays.par_iter().filter(|ray| !fast.any_hit(ray, &mut NoCount)).count();
+            assert_eq!(any_misses, 0, "TriangleBvh ({isa}) at {center}: {any_misses} any-hit misses");
+        }
         let mesh = Arc::new(sphere.mesh);
         for &kind in AccelKind::ALL.iter().filter(|&&k| k != AccelKind::None) {
             let world = World::build(vec![Object::Mesh(mesh.clone())], kind).unwrap();
