@@ -19,7 +19,8 @@
 //! the box grown by a small margin (`2^-18`, 32 units in the last place, of the largest coordinate of the grid's box): where a
 //! ray crosses near an edge or a corner of cells, rounding may order its crossings wrongly by that
 //! much, and a primitive touching that corner is then in whichever cell the traversal visits.
-//! Lists are filled in primitive order (so each is sorted) in two passes: count, then place.
+//! Each primitive's cells are found once, then counted and placed, in primitive order (so each
+//! list is sorted).
 //! Given a clipper (as the kd-tree is, see [`crate::shapes::clip_triangle`]), a primitive is left
 //! out of the cells its box overlaps but its shape does not: a long thin triangle lying across the
 //! diagonal of its box touches a few of the cells the box covers, and every cell it is wrongly
@@ -101,24 +102,6 @@ impl Frame {
         std::array::from_fn(|a| (cell(b.min[a] - self.margin, a), cell(b.max[a] + self.margin, a)))
     }
 
-    /// Cell `(x, y, z)` as a box, grown by the margin.
-    fn cell_box(&self, x: u32, y: u32, z: u32) -> Aabb {
-        let (min, max) = (self.bounds.min, self.bounds.max);
-        let at = [x, y, z];
-        let bound = |a: usize, i: u32| {
-            if self.inv_cell_size[a] == 0.0 || i >= self.res[a] {
-                max[a]
-            } else if i == 0 {
-                min[a]
-            } else {
-                min[a] + i as f32 / self.inv_cell_size[a]
-            }
-        };
-        let lo = glam::Vec3::from_array(std::array::from_fn(|a| if at[a] == 0 { min[a] } else { bound(a, at[a]) }));
-        let hi = glam::Vec3::from_array(std::array::from_fn(|a| bound(a, at[a] + 1)));
-        Aabb::new(lo - self.margin, hi + self.margin)
-    }
-
     fn cells(&self) -> u64 {
         self.res.iter().map(|&r| r as u64).product()
     }
@@ -177,57 +160,67 @@ pub(super) fn build(boxes: &[Aabb], clip: Option<ClipFn<'_>>, params: GridParams
     fill(boxes, clip, frame, params.mailbox)
 }
 
-/// Counts, then places, every primitive in its cells.
+/// Finds every primitive's cells, then counts and places them into the cells' lists.
 fn fill(boxes: &[Aabb], clip: Option<ClipFn<'_>>, frame: Frame, mailbox: bool) -> Grid {
-    let [nx, ny, _] = frame.res.map(|r| r as usize);
-    let cells = frame.cells() as usize;
-    let index = |x: u32, y: u32, z: u32| (z as usize * ny + y as usize) * nx + x as usize;
-    // Calls `f` with every cell primitive `prim` is listed in.
-    let for_cells = |prim: usize, b: &Aabb, f: &mut dyn FnMut(usize)| {
+    let e = frame.bounds.extent();
+    let size = |a: usize| if e[a] > 0.0 { e[a] / frame.res[a] as f32 } else { 0.0 };
+    let mut grid = Grid {
+        bounds: frame.bounds,
+        res: frame.res,
+        cell_size: glam::Vec3::new(size(0), size(1), size(2)),
+        inv_cell_size: frame.inv_cell_size,
+        cell_start: Vec::new(),
+        refs: Vec::new(),
+        margin: frame.margin,
+        prim_count: boxes.len(),
+        mailbox,
+    };
+    let margin = glam::Vec3::splat(frame.margin);
+    // Every primitive's cells, in primitive order, with where each primitive's run ends: clipping
+    // is the costly part of the build, so it is done once per primitive and cell.
+    let (mut cells_of, mut ends) = (Vec::new(), Vec::new());
+    for (prim, b) in boxes.iter().enumerate().filter(|(_, b)| has_box(b)) {
         let r = frame.range(b);
         let whole_box = r.iter().all(|&(lo, hi)| lo == hi);
         for z in r[2].0..=r[2].1 {
             for y in r[1].0..=r[1].1 {
                 for x in r[0].0..=r[0].1 {
                     let touches = match clip {
-                        Some(clip) if !whole_box => !clip(prim as u32, &frame.cell_box(x, y, z)).is_empty(),
+                        Some(clip) if !whole_box => {
+                            let cell = grid.cell_bounds(x, y, z);
+                            !clip(prim as u32, &Aabb::new(cell.min - margin, cell.max + margin)).is_empty()
+                        }
                         _ => true,
                     };
                     if touches {
-                        f(index(x, y, z));
+                        cells_of.push(grid.linear(x, y, z) as u32);
                     }
                 }
             }
         }
-    };
+        ends.push((prim as u32, cells_of.len()));
+    }
+    let cells = frame.cells() as usize;
     let mut cell_start = vec![0u32; cells + 1];
-    for (prim, b) in boxes.iter().enumerate().filter(|(_, b)| has_box(b)) {
-        for_cells(prim, b, &mut |c| cell_start[c + 1] += 1);
+    for &c in &cells_of {
+        cell_start[c as usize + 1] += 1;
     }
     for c in 0..cells {
         cell_start[c + 1] += cell_start[c];
     }
-    let mut refs = vec![0u32; cell_start[cells] as usize];
+    let mut refs = vec![0u32; cells_of.len()];
     let mut cursor = cell_start.clone();
-    for (prim, b) in boxes.iter().enumerate().filter(|(_, b)| has_box(b)) {
-        for_cells(prim, b, &mut |c| {
-            refs[cursor[c] as usize] = prim as u32;
-            cursor[c] += 1;
-        });
+    let mut from = 0;
+    for &(prim, end) in &ends {
+        for &c in &cells_of[from..end] {
+            refs[cursor[c as usize] as usize] = prim;
+            cursor[c as usize] += 1;
+        }
+        from = end;
     }
-    let e = frame.bounds.extent();
-    let size = |a: usize| if e[a] > 0.0 { e[a] / frame.res[a] as f32 } else { 0.0 };
-    Grid {
-        bounds: frame.bounds,
-        res: frame.res,
-        cell_size: glam::Vec3::new(size(0), size(1), size(2)),
-        inv_cell_size: frame.inv_cell_size,
-        cell_start,
-        refs,
-        margin: frame.margin,
-        prim_count: boxes.len(),
-        mailbox,
-    }
+    grid.cell_start = cell_start;
+    grid.refs = refs;
+    grid
 }
 
 #[cfg(test)]

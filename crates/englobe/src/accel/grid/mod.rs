@@ -4,7 +4,7 @@
 //! * [`build`]: the resolution (about `lambda * N^(1/3)` cells per axis of a cube, cells as close
 //!   to cubes as the box's shape allows: Cleary and Wyvill 1988, "Analysis of an algorithm for fast
 //!   ray tracing using uniform space subdivision", The Visual Computer), capped in cells and
-//!   references before anything is allocated, and the cells' lists, filled in two passes.
+//!   references before anything is allocated, and the cells' lists, filled by a counting sort.
 //! * [`traverse`]: the 3D-DDA of Amanatides and Woo (1987), "A Fast Voxel Traversal Algorithm for
 //!   Ray Tracing" (Eurographics), with mailboxing and the check that the closest hit lies in the
 //!   current cell before stopping.
