@@ -68,6 +68,9 @@ fn work(accel: &impl Accel, mesh: &TriangleMesh, rays: &[Ray]) -> (f64, f64) {
     (c.exact_tests as f64 / n, c.nodes_visited as f64 / n)
 }
 
+// Ignored: it builds some twenty variants over four meshes (minutes, even in release) to print
+// the figures docs/accelerators.md quotes, and checks nothing the other tests do not; run it by
+// hand with the command at the top of this file.
 #[test]
 #[ignore = "figures for docs/accelerators.md, not a check"]
 fn print_the_figures() {
