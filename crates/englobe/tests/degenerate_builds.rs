@@ -9,9 +9,7 @@ mod common;
 
 use common::{check_all_structures, load_obj};
 use englobe::accel::validate::validate_bvh;
-use englobe::{
-    Aabb, Accel, AccelKind, AnyAccel, Bounded, Intersect, NoCount, Ray, Shape, Sphere, Triangle, TriangleMesh, Vec3,
-};
+use englobe::{Aabb, Accel, AccelKind, AnyAccel, Bounded, Intersect, Ray, Shape, Sphere, Triangle, TriangleMesh, Vec3};
 
 /// Most primitives per leaf of the SAH builders.
 const MAX_LEAF: usize = 8;
@@ -131,7 +129,7 @@ fn a_flat_mesh() {
 }
 
 /// Builds every structure over `boxes` once (triangles clipped exactly with `clip`), bounds its
-/// memory and depth, and compares its answers on `rays` with brute force's.
+/// memory and depth, and checks it (validator, answers on `rays`) against brute force.
 fn check_size_and_answers(
     boxes: &[Aabb],
     clip: englobe::accel::ClipFn<'_>,
@@ -139,16 +137,7 @@ fn check_size_and_answers(
     intersect: impl Fn(u32, &Ray) -> Option<englobe::PrimHit> + Copy,
     max_depth: usize,
 ) {
-    let brute = AnyAccel::build(AccelKind::None, boxes);
-    let expected: Vec<_> = rays
-        .iter()
-        .map(|r| {
-            (
-                brute.closest_hit(r, &mut NoCount, intersect),
-                brute.any_hit(r, &mut NoCount, |i, r| intersect(i, r).is_some()),
-            )
-        })
-        .collect();
+    let expected = common::brute_force_answers(boxes, rays, intersect);
     for &kind in AccelKind::ALL {
         let accel = AnyAccel::build_with_clipper(kind, boxes, clip);
         let stats = accel.stats();
@@ -163,11 +152,7 @@ fn check_size_and_answers(
         };
         assert!(stats.memory_bytes <= most, "{kind}: {} bytes for {} primitives", stats.memory_bytes, boxes.len());
         assert!(stats.depth <= max_depth, "{kind}: depth {}", stats.depth);
-        for (ray, (closest, any)) in rays.iter().zip(&expected) {
-            let got = accel.closest_hit(ray, &mut NoCount, intersect);
-            assert_eq!(got.map(|h| (h.prim, h.t)), closest.map(|h| (h.prim, h.t)), "{kind}: {ray:?}");
-            assert_eq!(accel.any_hit(ray, &mut NoCount, |i, r| intersect(i, r).is_some()), *any, "{kind}: {ray:?}");
-        }
+        common::check_structure(kind.name(), &accel, boxes, clip, rays, &expected, intersect).unwrap();
     }
 }
 

@@ -35,45 +35,69 @@ pub fn check_all_structures_clipped(
     rays: &[Ray],
     intersect: impl Fn(u32, &Ray) -> Option<PrimHit> + Copy,
 ) -> Result<(), String> {
+    let expected = brute_force_answers(boxes, rays, intersect);
+    let mut builds: Vec<(String, AnyAccel)> =
+        AccelKind::ALL.iter().map(|&k| (k.to_string(), AnyAccel::build_with_clipper(k, boxes, clip))).collect();
+    builds.push(("kdtree with box clipping".to_owned(), AnyAccel::build(AccelKind::KdTree, boxes)));
+    builds.push(("grid with box clipping".to_owned(), AnyAccel::build(AccelKind::Grid, boxes)));
+    for (kind, accel) in &builds {
+        check_structure(kind, accel, boxes, clip, rays, &expected, intersect)?;
+    }
+    Ok(())
+}
+
+/// Brute force's closest hit and any-hit answer for every ray.
+pub fn brute_force_answers(
+    boxes: &[Aabb],
+    rays: &[Ray],
+    intersect: impl Fn(u32, &Ray) -> Option<PrimHit> + Copy,
+) -> Vec<(Option<Hit>, bool)> {
     let brute = AnyAccel::build(AccelKind::None, boxes);
-    let expected: Vec<(Option<Hit>, bool)> = rays
-        .iter()
+    rays.iter()
         .map(|r| {
             (
                 brute.closest_hit(r, &mut NoCount, intersect),
                 brute.any_hit(r, &mut NoCount, |i, r| intersect(i, r).is_some()),
             )
         })
-        .collect();
-    let mut builds: Vec<(String, AnyAccel)> =
-        AccelKind::ALL.iter().map(|&k| (k.to_string(), AnyAccel::build_with_clipper(k, boxes, clip))).collect();
-    builds.push(("kdtree with box clipping".to_owned(), AnyAccel::build(AccelKind::KdTree, boxes)));
-    builds.push(("grid with box clipping".to_owned(), AnyAccel::build(AccelKind::Grid, boxes)));
-    for (kind, accel) in &builds {
-        if let Some(bvh) = accel.bvh() {
-            validate_bvh(bvh, boxes).map_err(|e| format!("{kind}: invalid tree: {e}"))?;
+        .collect()
+}
+
+/// Checks one built structure (`kind` names it in errors): its invariants (with the validator of
+/// its kind; grids built with `clip`), and its answers on `rays` against brute force's
+/// `expected`, with counting on and off.
+pub fn check_structure(
+    kind: &str,
+    accel: &AnyAccel,
+    boxes: &[Aabb],
+    clip: ClipFn<'_>,
+    rays: &[Ray],
+    expected: &[(Option<Hit>, bool)],
+    intersect: impl Fn(u32, &Ray) -> Option<PrimHit> + Copy,
+) -> Result<(), String> {
+    if let Some(bvh) = accel.bvh() {
+        validate_bvh(bvh, boxes).map_err(|e| format!("{kind}: invalid tree: {e}"))?;
+    }
+    if let Some(tree) = accel.kdtree() {
+        validate_kdtree(tree, boxes).map_err(|e| format!("{kind}: invalid tree: {e}"))?;
+    }
+    if let Some(grid) = accel.grid() {
+        validate_grid_clipped(grid, boxes, Some(clip)).map_err(|e| format!("{kind}: invalid grid: {e}"))?;
+    }
+    for (ray, &(closest, any)) in rays.iter().zip(expected) {
+        let got = accel.closest_hit(ray, &mut NoCount, intersect);
+        same_hit(closest, got).map_err(|e| format!("{kind}: closest hit of {ray:?}: {e}"))?;
+        let mut counts = WorkCounts::default();
+        let counted = accel.closest_hit(ray, &mut counts, intersect);
+        if counted != got {
+            return Err(format!("{kind}: counting changed the closest hit of {ray:?}: {got:?} then {counted:?}"));
         }
-        if let Some(tree) = accel.kdtree() {
-            validate_kdtree(tree, boxes).map_err(|e| format!("{kind}: invalid tree: {e}"))?;
+        let got_any = accel.any_hit(ray, &mut NoCount, |i, r| intersect(i, r).is_some());
+        if got_any != any {
+            return Err(format!("{kind}: any hit of {ray:?}: brute force says {any}, {kind} says {got_any}"));
         }
-        if let Some(grid) = accel.grid() {
-            validate_grid_clipped(grid, boxes, Some(clip)).map_err(|e| format!("{kind}: invalid grid: {e}"))?;
-        }
-        for (ray, &(closest, any)) in rays.iter().zip(&expected) {
-            let got = accel.closest_hit(ray, &mut NoCount, intersect);
-            same_hit(closest, got).map_err(|e| format!("{kind}: closest hit of {ray:?}: {e}"))?;
-            let mut counts = WorkCounts::default();
-            let counted = accel.closest_hit(ray, &mut counts, intersect);
-            if counted != got {
-                return Err(format!("{kind}: counting changed the closest hit of {ray:?}: {got:?} then {counted:?}"));
-            }
-            let got_any = accel.any_hit(ray, &mut NoCount, |i, r| intersect(i, r).is_some());
-            if got_any != any {
-                return Err(format!("{kind}: any hit of {ray:?}: brute force says {any}, {kind} says {got_any}"));
-            }
-            if closest.is_some() && !any {
-                return Err(format!("brute force: a closest hit but no any hit for {ray:?}"));
-            }
+        if closest.is_some() && !any {
+            return Err(format!("brute force: a closest hit but no any hit for {ray:?}"));
         }
     }
     Ok(())
