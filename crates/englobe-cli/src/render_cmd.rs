@@ -34,8 +34,9 @@ pub struct RenderArgs {
     /// Worker threads (default: all cores).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
     threads: Option<u32>,
-    /// Acceleration structure: none (brute force), bvh-seed, bvh-seed-ordered, bvh-sah, ...
-    #[arg(long, default_value = "bvh-sah", value_parser = parse_accel)]
+    /// Acceleration structure: bvh-wide (the fast path, eight-wide at both levels), none (brute
+    /// force), bvh-seed, bvh-seed-ordered, bvh-sah, bvh-ploc, bvh-sweep, kdtree, grid
+    #[arg(long, default_value = "bvh-wide", value_parser = parse_accel)]
     accel: AccelKind,
     /// Light transport: whitted (the seed's recursion) or path (Monte Carlo path tracing);
     /// overrides the scene's `integrator`.

@@ -161,7 +161,10 @@ pub enum AccelKind {
     KdTree,
     /// The uniform grid ([`Grid`]).
     Grid,
-    /// The binned SAH tree made eight-wide and traversed with SIMD ([`WideBvh`]).
+    /// The fast path. Alone over boxes ([`AnyAccel`]), the binned SAH tree made eight-wide and
+    /// traversed with SIMD, its leaves calling the exact test ([`WideBvh`]); in a
+    /// [`crate::World`], two levels of it: every mesh a [`TriangleBvh`] (triangles in SIMD
+    /// blocks) and a [`WideBvh`] over the objects on top.
     BvhWide,
 }
 
@@ -224,7 +227,7 @@ impl AccelKind {
             }
             AccelKind::Grid => "uniform grid of about 27 cells per primitive, traversed with the 3D-DDA and mailboxing",
             AccelKind::BvhWide => {
-                "the binned-SAH BVH made eight-wide, all children's boxes tested at once with SIMD (AVX2, AVX-512 or portable)"
+                "the fast path: eight-wide BVHs at both levels, meshes with triangles in SIMD blocks, children's boxes tested at once (AVX2, AVX-512 or portable)"
             }
         }
     }

@@ -1,25 +1,41 @@
-//! A world: a list of objects (shapes, meshes and mesh instances) with an acceleration structure
+//! A world: a list of objects (shapes, meshes and mesh instances) with acceleration structures
 //! over their bounded primitives. It answers closest-hit and any-hit queries in terms of objects,
 //! which is what a renderer or any other user of ray queries needs.
 //!
-//! Every bounded primitive (a sphere, a box, one triangle of a mesh, one whole instance) gets an
-//! index in the order the objects were given, and the structure is built over their boxes.
-//! Unbounded shapes (planes) stay outside the structure and are tested beside it, as the design of
-//! every production ray tracer does. Instances make a two-level hierarchy: see [`BottomLevel`].
-//! Structures that split primitives across cells (the kd-tree) get each triangle's exact part in a
-//! cell ([`clip_triangle`]), and the box's part for other shapes.
+//! Every bounded primitive (a sphere, a box, one triangle of a mesh, one whole instance) gets a
+//! number in the order the objects were given. Unbounded shapes (planes) stay beside the
+//! structures and are tested after them, as every production ray tracer does. Instances make a
+//! two-level hierarchy (Wald, Benthin and Slusallek 2003): a structure over the instances' boxes
+//! on top, one structure per distinct instanced mesh below ([`BottomLevel`]).
+//!
+//! What the kind builds:
+//!
+//! * [`AccelKind::BvhWide`], the fast path, is eight-wide at both levels, as Embree builds a
+//!   scene: the triangles of every plain mesh in one [`TriangleBvh`] (triangles in SIMD blocks in
+//!   its leaves, numbered as above, so one query covers them all with no overlap between
+//!   meshes); the shapes and instances in a [`crate::WideBvh`] whose leaves call the exact test;
+//!   every instanced mesh a [`TriangleBvh`] of its own.
+//! * The teaching structures are measured as the seed report measured its own: one structure of
+//!   the kind over every primitive (each triangle of a plain mesh among them), and instanced
+//!   meshes below in a structure of the same kind. Structures that split primitives across cells
+//!   (the kd-tree) get each triangle's exact part in a cell ([`clip_triangle`]), and the box's
+//!   part for other shapes.
+//!
+//! Every kind gives the same answers, bit for bit: a triangle's test is the same watertight test
+//! everywhere, and ties at equal `t` go to the lower number at every level.
 
 use std::sync::Arc;
 
 use glam::Vec3;
 
-mod instances;
+mod bottom;
+mod query;
 
-use crate::accel::{Accel, AccelKind, AnyAccel, Counters, HitRecord, MAX_PRIMITIVES, StructureStats};
-use crate::shapes::{Bounded, Instance, Intersect, PrimHit, Shape, TriangleMesh, WatertightRay, clip_triangle};
+use crate::accel::{Accel, AccelKind, AnyAccel, MAX_PRIMITIVES, StructureStats, TriangleBvh};
+use crate::shapes::{Bounded, Instance, Intersect, PrimHit, Shape, TriangleMesh, clip_triangle};
 use crate::{Aabb, Ray};
 
-pub use instances::BottomLevel;
+pub use bottom::BottomLevel;
 
 /// One object of a world.
 #[derive(Clone, Debug, PartialEq)]
@@ -103,18 +119,24 @@ pub struct WorldHit {
     pub v: f32,
 }
 
-/// Objects plus an acceleration structure over their bounded primitives.
+/// Objects plus acceleration structures over their bounded primitives.
 #[derive(Clone, Debug)]
 pub struct World {
     objects: Vec<Object>,
-    /// For each structure primitive, its object.
+    /// For each primitive number, its object.
     prim_object: Vec<u32>,
-    /// For each object, the index of its first structure primitive.
+    /// For each object, the number of its first primitive.
     object_first_prim: Vec<u32>,
-    /// Objects tested beside the structure.
+    /// Objects tested beside the structures.
     unbounded: Vec<u32>,
-    accel: AnyAccel,
     kind: AccelKind,
+    /// The structure over the primitives that are not in [`World::triangles`].
+    accel: AnyAccel,
+    /// The primitive number of each of `accel`'s primitives, where they are not all of them in
+    /// order (the fast path, whose `accel` holds only shapes and instances).
+    accel_prims: Option<Vec<u32>>,
+    /// The fast path: every triangle of every plain mesh, by primitive number.
+    triangles: Option<TriangleBvh>,
     /// Bottom-level structures, one per distinct instanced mesh, shared by its instances.
     bottom: Vec<BottomLevel>,
     /// For each object, the index of its bottom-level structure (instances only).
@@ -122,8 +144,22 @@ pub struct World {
 }
 
 impl World {
-    /// Builds a world over `objects` with the structure `kind`. Instances of the same mesh (the
-    /// same `Arc`) share one bottom-level structure, also of kind `kind`.
+    /// Builds a world over `objects` with the structure `kind` (see the [module](self) for what
+    /// each kind builds). Instances of the same mesh (the same `Arc`) share one bottom-level
+    /// structure.
+    ///
+    /// ```
+    /// use englobe::{AccelKind, NoCount, Ray, Sphere, TriangleMesh, Vec3, World};
+    ///
+    /// let floor = TriangleMesh::new(
+    ///     vec![Vec3::new(-5.0, 0.0, -5.0), Vec3::new(5.0, 0.0, -5.0), Vec3::new(0.0, 0.0, 5.0)],
+    ///     vec![[0, 1, 2]],
+    /// )?;
+    /// let world = World::build(vec![floor.into(), Sphere::new(Vec3::Y, 0.5).into()], AccelKind::BvhWide)?;
+    /// let hit = world.closest_hit(&Ray::new(Vec3::new(0.0, 3.0, 0.0), -Vec3::Y), &mut NoCount).expect("a hit");
+    /// assert_eq!((hit.object, hit.t), (1, 1.5));
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
     pub fn build(objects: Vec<Object>, kind: AccelKind) -> Result<World, WorldError> {
         let total: usize = objects
             .iter()
@@ -163,19 +199,52 @@ impl World {
                 }
             }
         }
-        // Split clipping: a triangle's exact part in a cell, any other shape's box's part.
-        let clip = |prim: u32, cell: &Aabb| {
-            let object = prim_object[prim as usize];
-            match &objects[object as usize] {
-                Object::Mesh(m) => clip_triangle(m.triangle(prim - object_first_prim[object as usize]).vertices, cell),
-                Object::Shape(Shape::Triangle(t)) => clip_triangle(t.vertices, cell),
-                _ => boxes[prim as usize].intersection(cell),
-            }
+        let (accel, accel_prims, triangles) = if kind == AccelKind::BvhWide {
+            let in_mesh = |prim: u32| matches!(objects[prim_object[prim as usize] as usize], Object::Mesh(_));
+            // Primitives that are not mesh triangles get no triangle: the builder leaves out
+            // triangles with non-finite corners.
+            let triangles = TriangleBvh::build_with(
+                total,
+                |prim| {
+                    let object = prim_object[prim as usize];
+                    match &objects[object as usize] {
+                        Object::Mesh(m) => m.triangle(prim - object_first_prim[object as usize]).vertices,
+                        _ => [Vec3::NAN; 3],
+                    }
+                },
+                Default::default(),
+            );
+            let others: Vec<u32> = (0..total as u32).filter(|&p| !in_mesh(p)).collect();
+            let other_boxes: Vec<Aabb> = others.iter().map(|&p| boxes[p as usize]).collect();
+            (AnyAccel::build(kind, &other_boxes), Some(others), Some(triangles))
+        } else {
+            // Split clipping: a triangle's exact part in a cell, any other shape's box's part.
+            let clip = |prim: u32, cell: &Aabb| {
+                let object = prim_object[prim as usize];
+                match &objects[object as usize] {
+                    Object::Mesh(m) => {
+                        clip_triangle(m.triangle(prim - object_first_prim[object as usize]).vertices, cell)
+                    }
+                    Object::Shape(Shape::Triangle(t)) => clip_triangle(t.vertices, cell),
+                    _ => boxes[prim as usize].intersection(cell),
+                }
+            };
+            (AnyAccel::build_with_clipper(kind, &boxes, &clip), None, None)
         };
-        let accel = AnyAccel::build_with_clipper(kind, &boxes, &clip);
         drop(boxes);
-        let (bottom, object_bottom) = instances::build_bottom_levels(&objects, kind);
-        Ok(World { objects, prim_object, object_first_prim, unbounded, accel, kind, bottom, object_bottom })
+        let (bottom, object_bottom) = bottom::build_bottom_levels(&objects, kind);
+        Ok(World {
+            objects,
+            prim_object,
+            object_first_prim,
+            unbounded,
+            kind,
+            accel,
+            accel_prims,
+            triangles,
+            bottom,
+            object_bottom,
+        })
     }
 
     /// The objects, in the order given.
@@ -188,14 +257,39 @@ impl World {
         self.kind
     }
 
-    /// The structure itself.
+    /// The structure over the bounded primitives: all of them, or on the fast path those that
+    /// are not triangles of a plain mesh (see [`World::triangles`]).
     pub fn accel(&self) -> &AnyAccel {
         &self.accel
     }
 
-    /// Size and shape of the (top-level) structure.
+    /// The fast path's structure over every triangle of every plain mesh (`None` for the
+    /// teaching structures). Its triangle numbers are the world's primitive numbers.
+    pub fn triangles(&self) -> Option<&TriangleBvh> {
+        self.triangles.as_ref()
+    }
+
+    /// Size and shape of the structures over the world's primitives (the instanced meshes'
+    /// structures are apart: see [`World::bottom_levels`]). On the fast path, the triangles' and
+    /// the other primitives' structures summed: counts and bytes added, the deeper depth, and no
+    /// SAH cost.
     pub fn stats(&self) -> StructureStats {
-        self.accel.stats()
+        let top = self.accel.stats();
+        let Some(triangles) = &self.triangles else { return top };
+        let t = triangles.stats();
+        let mut leaf_sizes = top.leaf_sizes;
+        for (a, b) in leaf_sizes.iter_mut().zip(t.leaf_sizes) {
+            *a += b;
+        }
+        StructureStats {
+            nodes: top.nodes + t.nodes,
+            leaves: top.leaves + t.leaves,
+            depth: top.depth.max(t.depth),
+            prim_refs: top.prim_refs + t.prim_refs,
+            memory_bytes: top.memory_bytes + t.memory_bytes,
+            sah_cost: None,
+            leaf_sizes,
+        }
     }
 
     /// The bottom-level structures, one per distinct instanced mesh.
@@ -208,103 +302,23 @@ impl World {
         self.objects.iter().map(Object::triangle_count).sum()
     }
 
-    /// Number of primitives in the structure (unbounded shapes not included).
+    /// Number of bounded primitives: shapes, instances and every triangle of a plain mesh
+    /// (unbounded shapes not included), whichever structure holds them.
     pub fn primitive_count(&self) -> usize {
         self.prim_object.len()
     }
 
     /// Box around the bounded primitives.
     pub fn bounds(&self) -> Aabb {
-        self.accel.bounds()
+        let b = self.accel.bounds();
+        self.triangles.as_ref().map_or(b, |t| b.union(&t.bounds()))
     }
 
+    /// The object of primitive `prim`, and the primitive's index within it.
     #[inline(always)]
     fn locate(&self, prim: u32) -> (u32, u32) {
         let object = self.prim_object[prim as usize];
         (object, prim - self.object_first_prim[object as usize])
-    }
-
-    /// The closest hit, or `None`. Ties at equal `t` go to the lower object (then primitive) index.
-    pub fn closest_hit<C: Counters>(&self, ray: &Ray, counters: &mut C) -> Option<WorldHit> {
-        if !ray.is_valid() {
-            return None;
-        }
-        // Work inside instances is counted apart (the structure holds `counters` during its query)
-        // and merged afterwards.
-        let mut nested = C::default();
-        let mut instance_hits = instances::ClosestInstance::default();
-        let w = WatertightRay::new(ray);
-        let found = self.accel.closest_hit(ray, counters, |prim, r| {
-            let (object, local) = self.locate(prim);
-            match &self.objects[object as usize] {
-                Object::Shape(s) => s.intersect(r),
-                Object::Mesh(m) => m.intersect_with(local, r, &w),
-                Object::Instance(inst) => {
-                    let hit = self.instance_closest_hit(object, inst, r, &mut nested)?;
-                    instance_hits.offer(prim, &hit);
-                    Some(PrimHit { t: hit.t, u: hit.u, v: hit.v })
-                }
-            }
-        });
-        counters.merge(&nested);
-        let mut best = found.map(|h| {
-            let (object, local) = self.locate(h.prim);
-            let prim = match &self.objects[object as usize] {
-                Object::Instance(inst) => instance_hits.triangle(h.prim, h.t).unwrap_or_else(|| {
-                    // Only a structure that breaks the tie rule of `HitRecord::offer` gets here:
-                    // ask the instance again, up to the hit.
-                    let r = ray.with_range(ray.t_min, h.t);
-                    self.instance_closest_hit(object, inst, &r, &mut C::default()).map_or(0, |x| x.prim)
-                }),
-                _ => local,
-            };
-            WorldHit { t: h.t, object, prim, u: h.u, v: h.v }
-        });
-        let mut record = HitRecord::new(ray.with_range(ray.t_min, best.map_or(ray.t_max, |b| b.t)));
-        for &object in &self.unbounded {
-            counters.exact_test();
-            let Object::Shape(shape) = &self.objects[object as usize] else { continue };
-            if let Some(hit) = shape.intersect(&record.ray) {
-                let better = match best {
-                    None => true,
-                    Some(b) => hit.t < b.t || (hit.t == b.t && object < b.object),
-                };
-                if better {
-                    record.ray.t_max = hit.t;
-                    best = Some(WorldHit { t: hit.t, object, prim: 0, u: hit.u, v: hit.v });
-                }
-            }
-        }
-        best
-    }
-
-    /// Whether anything is hit within the ray's interval (shadow rays).
-    pub fn any_hit<C: Counters>(&self, ray: &Ray, counters: &mut C) -> bool {
-        if !ray.is_valid() {
-            return false;
-        }
-        let unbounded_hit = self.unbounded.iter().any(|&object| {
-            counters.exact_test();
-            match &self.objects[object as usize] {
-                Object::Shape(s) => s.intersect(ray).is_some(),
-                Object::Mesh(_) | Object::Instance(_) => false,
-            }
-        });
-        if unbounded_hit {
-            return true;
-        }
-        let mut nested = C::default();
-        let w = WatertightRay::new(ray);
-        let hit = self.accel.any_hit(ray, counters, |prim, r| {
-            let (object, local) = self.locate(prim);
-            match &self.objects[object as usize] {
-                Object::Shape(s) => s.intersect(r).is_some(),
-                Object::Mesh(m) => m.intersect_with(local, r, &w).is_some(),
-                Object::Instance(inst) => self.instance_any_hit(object, inst, r, &mut nested),
-            }
-        });
-        counters.merge(&nested);
-        hit
     }
 
     /// The unit geometric normal at the hit point `p` (outward for closed shapes, by winding for

@@ -1,35 +1,51 @@
 //! The bottom level of the two-level hierarchy (Wald, Benthin and Slusallek 2003, "A Simple and
 //! Practical Method for Interactive Ray Tracing of Dynamic Scenes"): one structure per distinct
-//! instanced mesh, shared by all its instances, and the queries that move a ray into an
-//! instance's space and trace it there.
+//! instanced mesh, in the mesh's own space, shared by all its instances. On the fast path
+//! ([`AccelKind::BvhWide`]) it is a [`TriangleBvh`], triangles in SIMD blocks in its leaves; the
+//! teaching structures build one of their own kind over the triangles' boxes.
 //!
 //! A world query sees an instance as one primitive. Its closure returns the hit's `t`, `u` and `v`
 //! but has no room for the triangle that was hit, so the world keeps, beside the structure's own
 //! record, the best instance hit under the same rule as [`crate::accel::HitRecord::offer`]
-//! (closer, or as close with a lower primitive index). Every structure offers its candidates
+//! (closer, or as close with a lower primitive number). Every structure offers its candidates
 //! through that rule, so when the structure's answer is an instance, the record names the same
 //! instance, at the same `t`, and gives its triangle.
 
 use std::collections::HashMap;
 use std::sync::Arc;
 
-use super::{Object, World};
-use crate::accel::{Accel, AccelKind, AnyAccel, Counters, Hit, StructureStats};
-use crate::shapes::{Instance, TriangleMesh, WatertightRay, clip_triangle};
+use super::Object;
+use crate::accel::{Accel, AccelKind, AnyAccel, Counters, Hit, StructureStats, TriangleBvh};
+use crate::shapes::{TriangleMesh, WatertightRay, clip_triangle};
+use crate::{Aabb, Ray};
+
+/// The structure of a [`BottomLevel`].
+#[derive(Clone, Debug)]
+enum BottomAccel {
+    /// The fast path: triangles stored in the leaves.
+    Triangles(TriangleBvh),
+    /// A structure of the world's kind, its leaves tested through the mesh.
+    Generic(AnyAccel),
+}
 
 /// A structure over the triangles of one mesh, in the mesh's own space.
 #[derive(Clone, Debug)]
 pub struct BottomLevel {
     mesh: Arc<TriangleMesh>,
-    accel: AnyAccel,
+    accel: BottomAccel,
 }
 
 impl BottomLevel {
-    /// The structure `kind` over the triangles of `mesh`.
+    /// The structure `kind` over the triangles of `mesh`: a [`TriangleBvh`] for
+    /// [`AccelKind::BvhWide`], the structure `kind` over the triangles' boxes otherwise.
     pub fn build(mesh: Arc<TriangleMesh>, kind: AccelKind) -> Self {
-        let boxes: Vec<_> = (0..mesh.len() as u32).map(|t| mesh.triangle_bounds(t)).collect();
-        let clip = |t: u32, cell: &crate::Aabb| clip_triangle(mesh.triangle(t).vertices, cell);
-        let accel = AnyAccel::build_with_clipper(kind, &boxes, &clip);
+        let accel = if kind == AccelKind::BvhWide {
+            BottomAccel::Triangles(TriangleBvh::build(&mesh))
+        } else {
+            let boxes: Vec<_> = (0..mesh.len() as u32).map(|t| mesh.triangle_bounds(t)).collect();
+            let clip = |t: u32, cell: &Aabb| clip_triangle(mesh.triangle(t).vertices, cell);
+            BottomAccel::Generic(AnyAccel::build_with_clipper(kind, &boxes, &clip))
+        };
         BottomLevel { accel, mesh }
     }
 
@@ -40,27 +56,80 @@ impl BottomLevel {
 
     /// Size and shape of the structure.
     pub fn stats(&self) -> StructureStats {
-        self.accel.stats()
+        match &self.accel {
+            BottomAccel::Triangles(t) => t.stats(),
+            BottomAccel::Generic(a) => a.stats(),
+        }
+    }
+
+    /// The fast structure, if this level has one.
+    pub fn triangle_bvh(&self) -> Option<&TriangleBvh> {
+        match &self.accel {
+            BottomAccel::Triangles(t) => Some(t),
+            BottomAccel::Generic(_) => None,
+        }
+    }
+
+    /// The closest triangle hit by `ray`, given in the mesh's space: `prim` is the triangle.
+    #[inline]
+    pub fn closest_hit<C: Counters>(&self, ray: &Ray, counters: &mut C) -> Option<Hit> {
+        match &self.accel {
+            BottomAccel::Triangles(t) => t.closest_hit(ray, counters),
+            BottomAccel::Generic(accel) => {
+                // The mesh's box first: brute force has no root box of its own to skip the mesh with.
+                counters.box_tests(1);
+                accel.bounds().intersect(ray)?;
+                let w = WatertightRay::new(ray);
+                accel.closest_hit(ray, counters, |tri, r| self.mesh.intersect_with(tri, r, &w))
+            }
+        }
+    }
+
+    /// Whether `ray`, given in the mesh's space, hits a triangle within its interval.
+    #[inline]
+    pub fn any_hit<C: Counters>(&self, ray: &Ray, counters: &mut C) -> bool {
+        match &self.accel {
+            BottomAccel::Triangles(t) => t.any_hit(ray, counters),
+            BottomAccel::Generic(accel) => {
+                counters.box_tests(1);
+                if accel.bounds().intersect(ray).is_none() {
+                    return false;
+                }
+                let w = WatertightRay::new(ray);
+                accel.any_hit(ray, counters, |tri, r| self.mesh.intersect_with(tri, r, &w).is_some())
+            }
+        }
     }
 }
 
 /// One bottom-level structure per distinct mesh (by `Arc` identity) among the instances, and for
-/// every object the index of its structure (`u32::MAX` for objects that are not instances).
+/// every object the index of its structure ([`NOT_NESTED`] for objects that are not instances).
+/// Distinct meshes are built in parallel where the `parallel` feature allows.
 pub(super) fn build_bottom_levels(objects: &[Object], kind: AccelKind) -> (Vec<BottomLevel>, Vec<u32>) {
-    let mut bottom = Vec::new();
+    let mut meshes: Vec<Arc<TriangleMesh>> = Vec::new();
     let mut by_mesh: HashMap<*const TriangleMesh, u32> = HashMap::new();
     let object_bottom = objects
         .iter()
         .map(|o| match o {
             Object::Instance(inst) => *by_mesh.entry(Arc::as_ptr(inst.mesh())).or_insert_with(|| {
-                bottom.push(BottomLevel::build(inst.mesh().clone(), kind));
-                (bottom.len() - 1) as u32
+                meshes.push(inst.mesh().clone());
+                (meshes.len() - 1) as u32
             }),
-            _ => u32::MAX,
+            _ => NOT_NESTED,
         })
         .collect();
+    #[cfg(feature = "parallel")]
+    let bottom = {
+        use rayon::prelude::*;
+        meshes.into_par_iter().map(|m| BottomLevel::build(m, kind)).collect()
+    };
+    #[cfg(not(feature = "parallel"))]
+    let bottom = meshes.into_iter().map(|m| BottomLevel::build(m, kind)).collect();
     (bottom, object_bottom)
 }
+
+/// The bottom level of an object that is not an instance.
+pub(super) const NOT_NESTED: u32 = u32::MAX;
 
 /// The best instance hit offered during one world query: its world primitive, `t` and triangle.
 #[derive(Clone, Copy, Debug, Default)]
@@ -88,56 +157,14 @@ impl ClosestInstance {
     }
 }
 
-impl World {
-    /// The closest hit of `ray` (in world space) with the mesh of `inst`, object `object`: `prim`
-    /// of the answer is the triangle, `t` is the world ray's parameter.
-    #[inline]
-    pub(super) fn instance_closest_hit<C: Counters>(
-        &self,
-        object: u32,
-        inst: &Instance,
-        ray: &crate::Ray,
-        counters: &mut C,
-    ) -> Option<Hit> {
-        let bottom = &self.bottom[self.object_bottom[object as usize] as usize];
-        let local = inst.local_ray(ray);
-        // The mesh's box first: brute force has no root box of its own to skip the mesh with.
-        counters.box_tests(1);
-        bottom.accel.bounds().intersect(&local)?;
-        let mesh = &bottom.mesh;
-        let w = WatertightRay::new(&local);
-        bottom.accel.closest_hit(&local, counters, |tri, r| mesh.intersect_with(tri, r, &w))
-    }
-
-    /// Whether `ray` hits the mesh of `inst` within its interval.
-    #[inline]
-    pub(super) fn instance_any_hit<C: Counters>(
-        &self,
-        object: u32,
-        inst: &Instance,
-        ray: &crate::Ray,
-        counters: &mut C,
-    ) -> bool {
-        let bottom = &self.bottom[self.object_bottom[object as usize] as usize];
-        let local = inst.local_ray(ray);
-        counters.box_tests(1);
-        if bottom.accel.bounds().intersect(&local).is_none() {
-            return false;
-        }
-        let mesh = &bottom.mesh;
-        let w = WatertightRay::new(&local);
-        bottom.accel.any_hit(&local, counters, |tri, r| mesh.intersect_with(tri, r, &w).is_some())
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use glam::{Affine3A, Quat, Vec3};
 
     use super::*;
     use crate::accel::{NoCount, WorkCounts};
-    use crate::shapes::Sphere;
-    use crate::{Ray, WorldHit};
+    use crate::shapes::{Instance, Sphere};
+    use crate::{World, WorldHit};
 
     fn cube() -> Arc<TriangleMesh> {
         let p = (0..8).map(|i| Vec3::new((i & 1) as f32, ((i >> 1) & 1) as f32, ((i >> 2) & 1) as f32)).collect();
@@ -175,6 +202,31 @@ mod tests {
         assert_eq!(w.primitive_count(), 6);
         assert_eq!(w.triangle_count(), 72);
         assert_eq!(Arc::strong_count(&mesh), 6 + 1, "five instances, one structure, and this handle");
+    }
+
+    #[test]
+    fn on_the_fast_path_every_mesh_is_a_triangle_bvh() {
+        let mesh = cube();
+        let objects: Vec<Object> = vec![
+            Object::Mesh(mesh.clone()),
+            Instance::new(mesh.clone(), Affine3A::from_translation(Vec3::X * 3.0)).unwrap().into(),
+            Object::Mesh(cube()),
+            Sphere::new(Vec3::new(0.0, 5.0, 0.0), 1.0).into(),
+        ];
+        let w = World::build(objects, AccelKind::BvhWide).unwrap();
+        assert_eq!(w.bottom_levels().len(), 1);
+        assert!(w.bottom_levels()[0].triangle_bvh().is_some());
+        // The plain meshes' triangles in one structure, the instance and the sphere in the other.
+        assert_eq!(w.triangles().unwrap().stats().prim_refs, 24);
+        assert_eq!(w.accel().stats().prim_refs, 2);
+        assert_eq!(w.primitive_count(), 12 + 1 + 12 + 1);
+        assert_eq!(w.stats().prim_refs, 12 + 1 + 12 + 1);
+        let hit = w.closest_hit(&Ray::new(Vec3::new(3.25, 0.75, -1.0), Vec3::Z), &mut NoCount).unwrap();
+        assert_eq!((hit.object, hit.prim, hit.t), (1, 0, 1.0));
+        let hit = w.closest_hit(&Ray::new(Vec3::new(0.25, 0.75, -1.0), Vec3::Z), &mut NoCount).unwrap();
+        assert_eq!((hit.object, hit.prim, hit.t), (0, 0, 1.0), "the first of two identical meshes");
+        let hit = w.closest_hit(&Ray::new(Vec3::new(0.0, 9.0, 0.0), -Vec3::Y), &mut NoCount).unwrap();
+        assert_eq!((hit.object, hit.prim, hit.t), (3, 0, 3.0));
     }
 
     #[test]
@@ -224,18 +276,23 @@ mod tests {
         let mesh = cube();
         let near = Affine3A::from_translation(Vec3::new(0.0, 0.0, 5.0));
         let far = Affine3A::from_translation(Vec3::new(0.0, 0.0, 5.5));
-        // The far one first: the near one has the higher index but the smaller t.
-        let w = World::build(
-            vec![Instance::new(mesh.clone(), far).unwrap().into(), Instance::new(mesh, near).unwrap().into()],
-            AccelKind::None,
-        )
-        .unwrap();
-        let ray = Ray::new(Vec3::new(0.25, 0.75, 0.0), Vec3::Z);
-        let hit: WorldHit = w.closest_hit(&ray, &mut NoCount).unwrap();
-        assert_eq!((hit.object, hit.t), (1, 5.0));
-        // The face z = 0 is triangles 0 and 1; (0.25, 0.75) lies in the second.
-        assert_eq!(hit.prim, 0);
-        assert_eq!(w.geometric_normal(&hit, ray.at(hit.t)), -Vec3::Z);
-        assert!(!w.any_hit(&Ray::segment(Vec3::new(0.25, 0.75, 0.0), Vec3::Z, 0.0, 4.9), &mut NoCount));
+        for kind in [AccelKind::None, AccelKind::BvhWide, AccelKind::KdTree] {
+            // The far one first: the near one has the higher index but the smaller t.
+            let w = World::build(
+                vec![
+                    Instance::new(mesh.clone(), far).unwrap().into(),
+                    Instance::new(mesh.clone(), near).unwrap().into(),
+                ],
+                kind,
+            )
+            .unwrap();
+            let ray = Ray::new(Vec3::new(0.25, 0.75, 0.0), Vec3::Z);
+            let hit: WorldHit = w.closest_hit(&ray, &mut NoCount).unwrap();
+            assert_eq!((hit.object, hit.t), (1, 5.0), "{kind}");
+            // The face z = 0 is triangles 0 and 1; (0.25, 0.75) lies in the second.
+            assert_eq!(hit.prim, 0, "{kind}");
+            assert_eq!(w.geometric_normal(&hit, ray.at(hit.t)), -Vec3::Z);
+            assert!(!w.any_hit(&Ray::segment(Vec3::new(0.25, 0.75, 0.0), Vec3::Z, 0.0, 4.9), &mut NoCount));
+        }
     }
 }
