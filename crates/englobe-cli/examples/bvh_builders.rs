@@ -16,8 +16,8 @@ use std::time::Instant;
 use anyhow::Context;
 use englobe::Aabb;
 use englobe::accel::Bvh;
+use englobe::accel::bvh::validate_bvh;
 use englobe::accel::bvh::{BinnedSah, Ploc, SeedPairing, SweepSah};
-use englobe::accel::validate::validate_bvh;
 use englobe_scene::mesh::load_mesh_file;
 
 /// A builder with its settings, ready to run on boxes.

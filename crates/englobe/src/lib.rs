@@ -4,7 +4,8 @@
 //! englobants*: bounding volumes, the answer a 2009 student report gave to the question "which
 //! objects can a ray possibly hit?", and the thread this library follows.
 //!
-//! * Geometry: [`Ray`], [`Aabb`] and the [`shapes`] (sphere, plane, box, triangle, mesh, instance).
+//! * Geometry: [`Ray`], [`Aabb`], [`PrimHit`] ([`geom`]) and the [`shapes`] (sphere, plane, box,
+//!   triangle, mesh, instance).
 //! * Acceleration structures behind one interface, [`accel::Accel`], with work counters.
 //! * [`World`]: objects plus a structure, answering closest-hit and any-hit queries.
 //!
@@ -17,17 +18,15 @@
 //! # Ok::<(), englobe::WorldError>(())
 //! ```
 
-pub mod aabb;
 pub mod accel;
-pub mod ray;
+pub mod geom;
 pub mod shapes;
 pub mod world;
 
-pub use aabb::Aabb;
 pub use accel::{Accel, AccelKind, AnyAccel, Counters, Hit, NoCount, TriangleBvh, WideBvh, WorkCounts};
+pub use geom::{Aabb, PrimHit, Ray};
 pub use glam::{Affine3A, Mat4, Vec2, Vec3};
-pub use ray::Ray;
-pub use shapes::{AaBox, Bounded, Instance, Intersect, Plane, PrimHit, Shape, Sphere, Triangle, TriangleMesh};
+pub use shapes::{AaBox, Bounded, Instance, Intersect, Plane, Shape, Sphere, Triangle, TriangleMesh};
 pub use world::{BottomLevel, Object, World, WorldError, WorldHit};
 
 // The README's examples are compiled and run as doctests.

@@ -8,7 +8,7 @@
 mod common;
 
 use common::{check_all_structures, load_obj};
-use englobe::accel::validate::validate_bvh;
+use englobe::accel::bvh::validate_bvh;
 use englobe::{Aabb, Accel, AccelKind, AnyAccel, Bounded, Intersect, Ray, Shape, Sphere, Triangle, TriangleMesh, Vec3};
 
 /// Most primitives per leaf of the SAH builders.

@@ -7,7 +7,7 @@
 mod common;
 
 use common::{check_all_structures_clipped, load_obj};
-use englobe::accel::validate::validate_bvh;
+use englobe::accel::bvh::validate_bvh;
 use englobe::shapes::clip_triangle;
 use englobe::{Aabb, Accel, AccelKind, AnyAccel, NoCount, Ray, Vec3, WorkCounts};
 

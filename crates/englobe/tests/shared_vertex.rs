@@ -7,8 +7,8 @@
 //! the box test keep these hits: switched off, the box of a triangle hit at the apex is rejected
 //! for some of the same rays.
 
-use englobe::aabb::ROBUST_FAR_SCALE;
 use englobe::accel::Isa;
+use englobe::geom::aabb::ROBUST_FAR_SCALE;
 use englobe::{Aabb, AccelKind, NoCount, Ray, TriangleBvh, TriangleMesh, Vec3, World};
 
 /// SplitMix64, so that failures reproduce.

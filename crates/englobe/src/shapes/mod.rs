@@ -20,27 +20,7 @@ pub use triangle::{Triangle, WatertightRay, intersect_triangle, is_degenerate};
 
 use glam::Vec3;
 
-use crate::{Aabb, Ray};
-
-/// Where a ray meets one primitive: its parameter `t` and two surface coordinates (barycentric
-/// weights of the second and third vertex for triangles, zero for other shapes).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct PrimHit {
-    /// Ray parameter of the hit.
-    pub t: f32,
-    /// First surface coordinate.
-    pub u: f32,
-    /// Second surface coordinate.
-    pub v: f32,
-}
-
-impl PrimHit {
-    /// A hit with no surface coordinates.
-    #[inline(always)]
-    pub fn at(t: f32) -> Self {
-        PrimHit { t, u: 0.0, v: 0.0 }
-    }
-}
+use crate::{Aabb, PrimHit, Ray};
 
 /// Anything with a bounding box. Unbounded shapes (planes) return a box with infinite corners.
 pub trait Bounded {

@@ -14,7 +14,7 @@
 use glam::Vec3;
 
 use super::{Bounded, Intersect, PrimHit};
-use crate::aabb::ROBUST_FAR_SCALE;
+use crate::geom::aabb::ROBUST_FAR_SCALE;
 use crate::{Aabb, Ray};
 
 /// A triangle given by its three vertices.

@@ -31,8 +31,9 @@ use glam::Vec3;
 mod bottom;
 mod query;
 
+use crate::PrimHit;
 use crate::accel::{Accel, AccelKind, AnyAccel, MAX_PRIMITIVES, StructureStats, TriangleBvh};
-use crate::shapes::{Bounded, Instance, Intersect, PrimHit, Shape, TriangleMesh, clip_triangle};
+use crate::shapes::{Bounded, Instance, Intersect, Shape, TriangleMesh, clip_triangle};
 use crate::{Aabb, Ray};
 
 pub use bottom::BottomLevel;

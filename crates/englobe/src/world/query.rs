@@ -10,9 +10,10 @@
 
 use super::bottom::ClosestInstance;
 use super::{Object, World, WorldHit};
+use crate::PrimHit;
 use crate::Ray;
 use crate::accel::{Accel, Counters, Hit};
-use crate::shapes::{Instance, Intersect, PrimHit, WatertightRay};
+use crate::shapes::{Instance, Intersect, WatertightRay};
 
 /// Whether `hit` beats `best` under the rule of the module.
 #[inline(always)]

@@ -6,16 +6,13 @@
 
 use std::path::PathBuf;
 
-use englobe::accel::ClipFn;
-use englobe::accel::grid::stats::validate_grid_clipped;
-use englobe::accel::kdtree::stats::validate_kdtree;
-use englobe::accel::validate::validate_bvh;
+use englobe::accel::{ClipFn, Validate};
 use englobe::{Aabb, Accel, AccelKind, AnyAccel, Hit, NoCount, PrimHit, Ray, TriangleMesh, Vec3, WorkCounts};
 
 /// Relative tolerance on the closest hit's `t`.
 pub const T_TOLERANCE: f32 = 1e-6;
 
-/// Builds every structure over `boxes`, validates the trees and grids, and checks that each one
+/// Builds every structure over `boxes`, validates each one, and checks that each one
 /// gives the same closest hit (same primitive, `t` within [`T_TOLERANCE`] relative) and the same
 /// any-hit answer as brute force for every ray, with counting on and off. Returns the first
 /// disagreement.
@@ -63,8 +60,8 @@ pub fn brute_force_answers(
         .collect()
 }
 
-/// Checks one built structure (`kind` names it in errors): its invariants (with the validator of
-/// its kind; grids built with `clip`), and its answers on `rays` against brute force's
+/// Checks one built structure (`kind` names it in errors): its invariants (every structure's
+/// [`Validate`]; grids built with `clip`), and its answers on `rays` against brute force's
 /// `expected`, with counting on and off.
 pub fn check_structure(
     kind: &str,
@@ -75,14 +72,9 @@ pub fn check_structure(
     expected: &[(Option<Hit>, bool)],
     intersect: impl Fn(u32, &Ray) -> Option<PrimHit> + Copy,
 ) -> Result<(), String> {
-    if let Some(bvh) = accel.bvh() {
-        validate_bvh(bvh, boxes).map_err(|e| format!("{kind}: invalid tree: {e}"))?;
-    }
-    if let Some(tree) = accel.kdtree() {
-        validate_kdtree(tree, boxes).map_err(|e| format!("{kind}: invalid tree: {e}"))?;
-    }
-    if let Some(grid) = accel.grid() {
-        validate_grid_clipped(grid, boxes, Some(clip)).map_err(|e| format!("{kind}: invalid grid: {e}"))?;
+    let stats = accel.validate(boxes, Some(clip)).map_err(|e| format!("{kind}: {e}"))?;
+    if stats != accel.stats() {
+        return Err(format!("{kind}: the validator measured {stats:?}, the structure reports {:?}", accel.stats()));
     }
     for (ray, &(closest, any)) in rays.iter().zip(expected) {
         let got = accel.closest_hit(ray, &mut NoCount, intersect);

@@ -7,46 +7,33 @@
 //! child; a leaf holds a range of `prim_indices`. The tree records its depth so that traversals can
 //! size their stack once, without allocating per ray.
 //!
+//! * [`build`]: the builders (binned SAH, full sweep, PLOC with its Morton codes, treelets and
+//!   leaf collapse), each producing a [`BuildTree`].
 //! * [`layout`]: a builder's tree ([`BuildTree`]) laid out into a [`Bvh`].
-//! * [`seed_pairing`]: the seed report's builder ([`SeedPairing`]).
-//! * [`binned_sah`]: top-down, binned surface area heuristic ([`BinnedSah`]).
-//! * [`sweep_sah`]: top-down, every split candidate scored ([`SweepSah`]): the quality reference.
-//! * [`ploc`]: bottom-up, parallel locally-ordered clustering ([`Ploc`]), with [`morton`] codes
-//!   and the SAH leaf [`collapse`]; [`treelet`] restructuring improves its trees.
-//! * [`top_down`]: what the top-down builders share; [`parallel`]: their parallelism.
-//! * [`ordered`]: nearer child first, `t_max` shrinking at each hit (what `Bvh` answers queries with).
-//! * [`candidates`]: the seed report's own traversal ([`CandidateListBvh`]).
-//! * [`stats`]: node count, leaves, depth, memory and SAH cost.
+//! * [`ordered`]: nearer child first, `t_max` shrinking at each hit (what `Bvh` answers queries
+//!   with), over the [`slab`] test.
+//! * [`stats`]: node count, leaves, depth, memory and SAH cost; [`validate`]: the invariants.
+//!
+//! The seed report's builder and traversal are in [`crate::accel::reference`].
 
-pub mod binned_sah;
-pub mod candidates;
-pub mod collapse;
+pub mod build;
 pub mod layout;
-pub mod morton;
 pub mod ordered;
-pub mod parallel;
-pub mod ploc;
-pub mod seed_pairing;
 pub mod slab;
 pub mod stats;
-pub mod sweep_sah;
-pub mod top_down;
-pub mod treelet;
+pub mod validate;
 
 use std::ops::Range;
 
 use glam::Vec3;
 
-pub use binned_sah::BinnedSah;
-pub use candidates::CandidateListBvh;
+pub use build::{BinnedSah, Ploc, SweepSah};
 pub use layout::{BuildKind, BuildNode, BuildTree};
-pub use ploc::Ploc;
-pub use seed_pairing::SeedPairing;
 pub use stats::{SAH_INTERSECTION_COST, SAH_TRAVERSAL_COST};
-pub use sweep_sah::SweepSah;
+pub use validate::{BvhError, BvhQuality, validate_bvh};
 
-use super::{Accel, Counters, Hit, StructureStats};
-use crate::shapes::PrimHit;
+use crate::PrimHit;
+use crate::accel::{Accel, Counters, Hit, StructureStats};
 use crate::{Aabb, Ray};
 
 /// One node of a [`Bvh`]: its box, and either its second child (interior node; the first child is
@@ -138,7 +125,7 @@ impl Bvh {
         Bvh::default()
     }
 
-    /// A tree from its parts, unchecked: [`crate::accel::validate::validate_bvh`] says whether it
+    /// A tree from its parts, unchecked: [`crate::accel::bvh::validate::validate_bvh`] says whether it
     /// is well formed. Queries on a malformed tree give wrong answers or panic, never worse.
     pub(crate) fn from_parts(nodes: Vec<BvhNode>, prim_indices: Vec<u32>, depth: u32) -> Self {
         Bvh { nodes, prim_indices, depth }

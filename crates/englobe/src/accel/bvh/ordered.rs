@@ -34,10 +34,10 @@ use std::cell::Cell;
 
 use super::slab::RaySlabs;
 use super::{Bvh, BvhNode, SECOND_IS_LOWER};
+use crate::PrimHit;
 use crate::Ray;
-use crate::aabb::ROBUST_FAR_SCALE;
 use crate::accel::{Counters, Hit, HitRecord};
-use crate::shapes::PrimHit;
+use crate::geom::aabb::ROBUST_FAR_SCALE;
 
 /// Depth up to which the traversal stack lives in a fixed array (a balanced tree this deep holds
 /// 2^64 leaves).
@@ -238,8 +238,9 @@ mod tests {
 
     use super::*;
     use crate::Aabb;
+    use crate::accel::SeedPairing;
     use crate::accel::WorkCounts;
-    use crate::accel::bvh::{BuildKind, BuildNode, BuildTree, SeedPairing};
+    use crate::accel::bvh::{BuildKind, BuildNode, BuildTree};
     use crate::shapes::{Intersect, Sphere};
 
     fn row(n: usize) -> Vec<Sphere> {

@@ -15,7 +15,7 @@ use glam::{BVec3A, Vec3A, Vec4};
 
 use super::BvhNode;
 use crate::Ray;
-use crate::aabb::ROBUST_FAR_SCALE;
+use crate::geom::aabb::ROBUST_FAR_SCALE;
 
 /// A ray prepared for slab tests.
 #[derive(Clone, Copy, Debug)]

@@ -83,7 +83,7 @@ mod tests {
 
     use super::*;
     use crate::Aabb;
-    use crate::accel::bvh::SeedPairing;
+    use crate::accel::SeedPairing;
 
     #[test]
     fn two_disjoint_unit_cubes() {

@@ -21,7 +21,7 @@ pub mod traverse;
 use glam::Vec3;
 
 use super::{Accel, ClipFn, Counters, Hit, StructureStats};
-use crate::shapes::PrimHit;
+use crate::PrimHit;
 use crate::{Aabb, Ray};
 
 /// Build parameters. The defaults are those the measurements of `docs/accelerators.md` use.

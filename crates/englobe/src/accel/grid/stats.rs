@@ -11,7 +11,7 @@
 
 use super::Grid;
 use crate::Aabb;
-use crate::accel::{ClipFn, LEAF_SIZE_BUCKETS, StructureStats};
+use crate::accel::{ClipFn, InvalidStructure, LEAF_SIZE_BUCKETS, StructureStats, Validate};
 
 /// A broken invariant of a grid.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -187,6 +187,13 @@ pub fn validate_grid_clipped(
         refs_per_prim: if with_box == 0 { 0.0 } else { grid.refs.len() as f64 / with_box as f64 },
         max_cell,
     })
+}
+
+impl Validate for Grid {
+    fn validate(&self, prim_boxes: &[Aabb], clip: Option<ClipFn<'_>>) -> Result<StructureStats, InvalidStructure> {
+        validate_grid_clipped(self, prim_boxes, clip).map_err(|e| InvalidStructure::new("grid", e))?;
+        Ok(self.structure_stats())
+    }
 }
 
 #[cfg(test)]

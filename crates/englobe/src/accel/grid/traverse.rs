@@ -25,11 +25,11 @@
 use std::ops::ControlFlow;
 
 use super::Grid;
+use crate::PrimHit;
 use crate::Ray;
-use crate::aabb::gamma;
-use crate::accel::mailbox::Mailbox;
+use crate::accel::interface::mailbox::Mailbox;
 use crate::accel::{Counters, Hit, HitRecord};
-use crate::shapes::PrimHit;
+use crate::geom::aabb::gamma;
 
 /// Relative slack on a cell's exit distance when deciding that the closest hit lies inside it.
 pub const EXIT_SLACK: f32 = 8.0 * f32::EPSILON;

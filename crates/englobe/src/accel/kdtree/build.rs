@@ -21,9 +21,7 @@
 use super::events::{Event, EventKind, merge_events, prims_of, push_events, sort_events};
 use super::{KdNode, KdTree, KdTreeParams, MAX_NODES};
 use crate::Aabb;
-
-/// `clip(prim, cell)`: the box of the part of primitive `prim` inside `cell` (empty if none).
-pub type ClipFn<'a> = &'a (dyn Fn(u32, &Aabb) -> Aabb + Sync);
+use crate::accel::ClipFn;
 
 /// Leaf lists stop growing past this many entries (indices are 32-bit); nodes that would need
 /// more become leaves.

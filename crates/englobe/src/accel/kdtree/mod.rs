@@ -21,10 +21,9 @@ pub mod events;
 pub mod stats;
 pub mod traverse;
 
-pub use build::ClipFn;
-
 use super::{Accel, Counters, Hit, StructureStats};
-use crate::shapes::PrimHit;
+use crate::PrimHit;
+use crate::accel::ClipFn;
 use crate::{Aabb, Ray};
 
 /// Deepest tree built, whatever the parameters say: it bounds the traversal stack.

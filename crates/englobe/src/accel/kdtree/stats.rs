@@ -15,7 +15,7 @@
 use super::{KdTree, MAX_DEPTH};
 use crate::Aabb;
 use crate::accel::bvh::{SAH_INTERSECTION_COST, SAH_TRAVERSAL_COST};
-use crate::accel::{LEAF_SIZE_BUCKETS, StructureStats};
+use crate::accel::{ClipFn, InvalidStructure, LEAF_SIZE_BUCKETS, StructureStats, Validate};
 
 /// A broken invariant of a kd-tree.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -282,6 +282,13 @@ pub fn validate_kdtree(tree: &KdTree, prim_boxes: &[Aabb]) -> Result<KdTreeQuali
         max_leaf,
         sah_cost: tree.sah_cost(),
     })
+}
+
+impl Validate for KdTree {
+    fn validate(&self, prim_boxes: &[Aabb], _clip: Option<ClipFn<'_>>) -> Result<StructureStats, InvalidStructure> {
+        validate_kdtree(self, prim_boxes).map_err(|e| InvalidStructure::new("kd-tree", e))?;
+        Ok(self.structure_stats())
+    }
 }
 
 #[cfg(test)]

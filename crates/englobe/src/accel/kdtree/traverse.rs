@@ -29,10 +29,10 @@
 use std::ops::ControlFlow;
 
 use super::{KdTree, MAX_DEPTH};
+use crate::PrimHit;
 use crate::Ray;
-use crate::accel::mailbox::Mailbox;
+use crate::accel::interface::mailbox::Mailbox;
 use crate::accel::{Counters, Hit, HitRecord};
-use crate::shapes::PrimHit;
 
 /// Relative widening of the distances at which a ray crosses a split plane: eight units of
 /// roundoff, more than the three roundings of `(split - origin) * inv_dir` and of the primitives'

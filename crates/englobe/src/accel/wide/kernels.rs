@@ -14,7 +14,7 @@
 use glam::Vec4;
 
 use super::node::{NodeRay, WIDTH, WideNode};
-use crate::aabb::ROBUST_FAR_SCALE;
+use crate::geom::aabb::ROBUST_FAR_SCALE;
 
 /// A slab test of all children of a node.
 pub trait NodeKernel: Copy {

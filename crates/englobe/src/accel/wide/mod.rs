@@ -20,6 +20,7 @@
 //! * [`traverse`]: the single-ray traversal, generic over kernels and leaves.
 //! * [`triangles`]: blocks of four triangles and their SIMD watertight test; [`triangle_bvh`]:
 //!   [`TriangleBvh`].
+//! * [`validate`]: the invariants of both, checked.
 
 pub mod convert;
 pub mod dispatch;
@@ -29,17 +30,18 @@ pub mod node;
 pub mod traverse;
 pub mod triangle_bvh;
 pub mod triangles;
+pub mod validate;
 
 pub use isa::{Isa, IsaUnavailable};
 pub use triangle_bvh::{TriangleBvh, TriangleBvhOptions};
 
 use convert::{ConvertOptions, LeafSink, convert};
-use node::{EMPTY, MAX_LEAF_ITEMS, NodeRay, WIDTH, WideNode, index_of, is_leaf, reach};
+use node::{EMPTY, MAX_LEAF_ITEMS, NodeRay, WIDTH, WideNode, is_leaf, reach};
 use traverse::Leaves;
 
 use super::bvh::{BinnedSah, Bvh};
 use super::{Accel, Counters, Hit, HitRecord, LEAF_SIZE_BUCKETS, StructureStats};
-use crate::shapes::PrimHit;
+use crate::PrimHit;
 use crate::{Aabb, Ray};
 
 /// A wide BVH whose leaves hold primitive references, queried through closures like every
@@ -114,60 +116,6 @@ impl WideBvh {
     /// Wide nodes on the longest path from the root to a leaf.
     pub fn depth(&self) -> u32 {
         self.depth
-    }
-
-    /// Checks the tree: every node reached once from the root, every primitive of `boxes` in
-    /// exactly one leaf, child boxes inside their parent's, leaf boxes around their primitives,
-    /// the recorded depth.
-    pub fn validate(&self, boxes: &[Aabb]) -> Result<(), String> {
-        let mut seen = vec![0u32; boxes.len()];
-        let mut reached = vec![false; self.nodes.len()];
-        let mut depth = 0;
-        let mut stack = vec![(0u32, self.bounds, 1u32)];
-        if self.nodes.is_empty() {
-            stack.clear();
-        }
-        while let Some((i, parent, level)) = stack.pop() {
-            let node = self.nodes.get(i as usize).ok_or(format!("child {i} is not a node"))?;
-            if std::mem::replace(&mut reached[i as usize], true) {
-                return Err(format!("node {i} is reached twice"));
-            }
-            depth = depth.max(level);
-            for slot in (0..WIDTH).filter(|&s| node.children[s] != EMPTY) {
-                let b = node.child_bounds(slot);
-                if !parent.contains_box(&b) {
-                    return Err(format!("node {i}, slot {slot}: {b:?} is not inside {parent:?}"));
-                }
-                let c = node.children[slot];
-                if !is_leaf(c) {
-                    stack.push((c, b, level + 1));
-                    continue;
-                }
-                let first = index_of(c) as usize;
-                let range = first..first + node.counts[slot] as usize;
-                let prims = self.prim_indices.get(range).ok_or(format!("node {i}, slot {slot}: bad leaf range"))?;
-                if prims.is_empty() {
-                    return Err(format!("node {i}, slot {slot}: empty leaf"));
-                }
-                for &p in prims {
-                    let pb = boxes.get(p as usize).ok_or(format!("primitive {p} does not exist"))?;
-                    if !b.contains_box(pb) {
-                        return Err(format!("primitive {p} sticks out of its leaf (node {i}, slot {slot})"));
-                    }
-                    seen[p as usize] += 1;
-                }
-            }
-        }
-        if let Some(p) = seen.iter().position(|&s| s != 1) {
-            return Err(format!("primitive {p} is in {} leaves", seen[p]));
-        }
-        if let Some(n) = reached.iter().position(|&r| !r) {
-            return Err(format!("node {n} is not reachable"));
-        }
-        if depth != self.depth {
-            return Err(format!("recorded depth {}, real depth {depth}", self.depth));
-        }
-        Ok(())
     }
 }
 
@@ -292,7 +240,7 @@ mod tests {
     fn trees_deeper_than_the_inline_stack_agree_with_brute_force() {
         let (boxes, bvh) = chain(600);
         let mut wide = WideBvh::from_bvh(&bvh);
-        wide.validate(&boxes).unwrap();
+        crate::accel::Validate::validate(&wide, &boxes, None).unwrap();
         assert!(wide.depth() as usize > INLINE_DEPTH, "depth {}", wide.depth());
         let shapes: Vec<AaBox> = boxes.iter().map(|b| AaBox::new(b.min, b.max)).collect();
         let test = |i: u32, r: &Ray| crate::shapes::Intersect::intersect(&shapes[i as usize], r);

@@ -12,7 +12,7 @@
 //! with the number of items in [`WideNode::counts`]. Unused slots have [`EMPTY`] and an empty box
 //! (`+inf` below, `-inf` above) that no ray enters: the slab test rejects it without a special case.
 
-use crate::aabb::ROBUST_FAR_SCALE;
+use crate::geom::aabb::ROBUST_FAR_SCALE;
 use crate::{Aabb, Ray};
 
 /// Children per node.

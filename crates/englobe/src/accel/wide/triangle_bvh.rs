@@ -15,7 +15,7 @@ use super::node::{NodeRay, WideNode, reach};
 use super::traverse::Leaves;
 use super::triangles::{LANES, TriBlock, TriRay, UNUSED, intersect_block, is_storable};
 use crate::accel::bvh::BinnedSah;
-use crate::accel::bvh::parallel::fill_indexed;
+use crate::accel::bvh::build::parallel::fill_indexed;
 use crate::accel::{Counters, Hit, LEAF_SIZE_BUCKETS, MAX_PRIMITIVES, StructureStats};
 use crate::shapes::TriangleMesh;
 use crate::{Aabb, Ray};

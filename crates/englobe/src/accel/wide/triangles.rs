@@ -19,9 +19,10 @@
 
 use glam::{BVec4A, Vec3, Vec4};
 
+use crate::PrimHit;
 use crate::Ray;
-use crate::aabb::ROBUST_FAR_SCALE;
-use crate::shapes::{PrimHit, WatertightRay, intersect_triangle, is_degenerate};
+use crate::geom::aabb::ROBUST_FAR_SCALE;
+use crate::shapes::{WatertightRay, intersect_triangle, is_degenerate};
 
 /// Triangles per block.
 pub const LANES: usize = 4;

@@ -16,8 +16,8 @@
 use glam::Vec3A;
 
 use super::top_down::{self, PrimRef, Splitter, partition, split_beats_leaf};
-use super::{BuildTree, Bvh};
 use crate::Aabb;
+use crate::accel::bvh::{BuildTree, Bvh};
 
 /// Most bins per axis.
 pub const MAX_BINS: usize = 32;
@@ -173,7 +173,7 @@ mod tests {
     use glam::Vec3;
 
     use super::*;
-    use crate::accel::validate::validate_bvh;
+    use crate::accel::bvh::validate::validate_bvh;
 
     fn cube(c: Vec3, r: f32) -> Aabb {
         Aabb::new(c - Vec3::splat(r), c + Vec3::splat(r))

@@ -17,9 +17,10 @@
 
 use std::ops::ControlFlow;
 
-use super::{Counters, HitRecord};
+use super::HitRecord;
+use super::counters::Counters;
+use crate::PrimHit;
 use crate::Ray;
-use crate::shapes::PrimHit;
 
 /// Entries of the table (a power of two).
 pub const MAILBOX_SLOTS: usize = 64;

@@ -14,8 +14,8 @@
 //! primitives. Its quality depends entirely on how well the diagonal key keeps neighbours in space
 //! together, which is the point of measuring it.
 
-use super::{BuildKind, BuildNode, BuildTree, Bvh};
 use crate::Aabb;
+use crate::accel::bvh::{BuildKind, BuildNode, BuildTree, Bvh};
 
 /// The seed report's bottom-up pairing builder.
 #[derive(Clone, Copy, Debug, Default)]

@@ -22,10 +22,10 @@
 
 use glam::Vec3;
 
-use super::layout::{BuildKind, BuildNode, BuildTree};
 use super::parallel;
-use super::stats::{SAH_INTERSECTION_COST, SAH_TRAVERSAL_COST};
 use crate::Aabb;
+use crate::accel::bvh::layout::{BuildKind, BuildNode, BuildTree};
+use crate::accel::bvh::stats::{SAH_INTERSECTION_COST, SAH_TRAVERSAL_COST};
 
 /// A primitive as the top-down builders move it around: its box, its box's centre and its index.
 /// Builders reorder these in place; the final order becomes the leaves' primitive references.
@@ -212,7 +212,7 @@ pub fn partition(refs: &mut [PrimRef], mut left: impl FnMut(&PrimRef) -> bool) -
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::accel::validate::validate_bvh;
+    use crate::accel::bvh::validate::validate_bvh;
 
     /// Never splits: every range larger than a leaf is split by count.
     struct NoSplit(usize);

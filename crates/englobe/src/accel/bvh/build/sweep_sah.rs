@@ -16,8 +16,8 @@ use std::cmp::Ordering;
 
 use super::binned_sah::DEFAULT_MAX_LEAF;
 use super::top_down::{self, PrimRef, Splitter, split_beats_leaf};
-use super::{BuildTree, Bvh};
 use crate::Aabb;
+use crate::accel::bvh::{BuildTree, Bvh};
 
 /// The full-sweep SAH builder. `SweepSah::default()` makes leaves of at most 8 primitives, like
 /// [`super::BinnedSah::default()`], so that their trees compare.
@@ -112,7 +112,7 @@ mod tests {
 
     use super::*;
     use crate::accel::bvh::BinnedSah;
-    use crate::accel::validate::validate_bvh;
+    use crate::accel::bvh::validate::validate_bvh;
 
     fn cube(c: Vec3, r: f32) -> Aabb {
         Aabb::new(c - Vec3::splat(r), c + Vec3::splat(r))

@@ -31,14 +31,14 @@
 //! primitive per leaf; a final pass ([`super::collapse`]) collapses the subtrees that the SAH says
 //! cost less as a leaf, so that its trees compare with the top-down builders'.
 
-use super::Bvh;
 use super::binned_sah::DEFAULT_MAX_LEAF;
 use super::collapse::collapse_leaves;
-use super::layout::{BuildKind, BuildNode, BuildTree};
 use super::morton::MortonGrid;
 use super::parallel;
 use super::treelet::restructure;
 use crate::Aabb;
+use crate::accel::bvh::Bvh;
+use crate::accel::bvh::layout::{BuildKind, BuildNode, BuildTree};
 
 /// Rounds in which fewer than one cluster in this many merges also merge greedily (see the
 /// module documentation).
@@ -182,7 +182,7 @@ mod tests {
     use glam::Vec3;
 
     use super::*;
-    use crate::accel::validate::validate_bvh;
+    use crate::accel::bvh::validate::validate_bvh;
 
     fn cube(c: Vec3, r: f32) -> Aabb {
         Aabb::new(c - Vec3::splat(r), c + Vec3::splat(r))

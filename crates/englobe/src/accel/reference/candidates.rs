@@ -18,9 +18,10 @@
 
 use std::ops::ControlFlow;
 
-use super::{Bvh, SeedPairing};
-use crate::accel::{Accel, Counters, Hit, HitRecord, StructureStats};
-use crate::shapes::PrimHit;
+use super::SeedPairing;
+use crate::PrimHit;
+use crate::accel::bvh::Bvh;
+use crate::accel::{Accel, ClipFn, Counters, Hit, HitRecord, InvalidStructure, StructureStats, Validate};
 use crate::{Aabb, Ray};
 
 /// Candidates gathered before they are tested.
@@ -51,14 +52,14 @@ impl CandidateListBvh {
         counters: &mut C,
         found: &mut impl FnMut(u32, &mut C) -> ControlFlow<()>,
     ) -> ControlFlow<()> {
-        let node = &self.bvh.nodes[index];
+        let node = &self.bvh.nodes()[index];
         counters.box_tests(1);
         if node.bounds().intersect(ray).is_none() {
             return ControlFlow::Continue(());
         }
         counters.node_visited();
         if node.is_leaf() {
-            for &prim in &self.bvh.prim_indices[node.prim_range()] {
+            for &prim in &self.bvh.prim_indices()[node.prim_range()] {
                 found(prim, counters)?;
             }
             ControlFlow::Continue(())
@@ -76,7 +77,7 @@ impl CandidateListBvh {
         counters: &mut C,
         mut test: impl FnMut(&[u32], &mut C) -> ControlFlow<()>,
     ) {
-        if !ray.is_valid() || self.bvh.nodes.is_empty() {
+        if !ray.is_valid() || self.bvh.nodes().is_empty() {
             return;
         }
         let mut batch = [0u32; BATCH];
@@ -139,6 +140,12 @@ impl Accel for CandidateListBvh {
 
     fn stats(&self) -> StructureStats {
         self.bvh.structure_stats()
+    }
+}
+
+impl Validate for CandidateListBvh {
+    fn validate(&self, prim_boxes: &[Aabb], clip: Option<ClipFn<'_>>) -> Result<StructureStats, InvalidStructure> {
+        self.bvh().validate(prim_boxes, clip)
     }
 }
 

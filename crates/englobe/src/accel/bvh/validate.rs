@@ -14,9 +14,9 @@
 //! On success it returns [`BvhQuality`]: counts, depth, leaf sizes, SAH cost (see
 //! [`crate::accel::bvh::stats`]) and whether every box is the tightest possible.
 
-use super::LEAF_SIZE_BUCKETS;
-use super::bvh::{Bvh, INTERIOR, SECOND_IS_LOWER};
+use super::{Bvh, INTERIOR, SECOND_IS_LOWER};
 use crate::Aabb;
+use crate::accel::{ClipFn, InvalidStructure, LEAF_SIZE_BUCKETS, StructureStats, Validate};
 
 /// A broken invariant, naming the node or primitive at fault.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -280,12 +280,20 @@ pub fn validate_bvh(bvh: &Bvh, prim_boxes: &[Aabb]) -> Result<BvhQuality, BvhErr
     })
 }
 
+impl Validate for Bvh {
+    fn validate(&self, prim_boxes: &[Aabb], _clip: Option<ClipFn<'_>>) -> Result<StructureStats, InvalidStructure> {
+        validate_bvh(self, prim_boxes).map_err(|e| InvalidStructure::new("BVH", e))?;
+        Ok(self.structure_stats())
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use glam::Vec3;
 
     use super::*;
-    use crate::accel::bvh::{BvhNode, SeedPairing};
+    use crate::accel::SeedPairing;
+    use crate::accel::bvh::BvhNode;
 
     fn boxes(n: usize) -> Vec<Aabb> {
         (0..n).map(|i| Aabb::new(Vec3::splat(i as f32), Vec3::splat(i as f32 + 0.5))).collect()

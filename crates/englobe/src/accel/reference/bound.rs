@@ -10,9 +10,9 @@
 //! or only one for an occluded ray. (Spatial subdivisions such as kd-trees clip primitives to
 //! cells and can do better than this on some rays.)
 
-use super::bvh::{BinnedSah, Bvh};
-use super::{Accel, Counters, Hit, NoCount, StructureStats};
-use crate::shapes::PrimHit;
+use crate::PrimHit;
+use crate::accel::bvh::{BinnedSah, Bvh};
+use crate::accel::{Accel, ClipFn, Counters, Hit, InvalidStructure, NoCount, StructureStats, Validate};
 use crate::{Aabb, Ray};
 
 /// Answers like brute force but counts only the exact tests no BVH could avoid.
@@ -77,6 +77,18 @@ impl Accel for LowerBound {
             memory_bytes: self.bvh.stats().memory_bytes + self.boxes.len() * std::mem::size_of::<Aabb>(),
             ..StructureStats::default()
         }
+    }
+}
+
+impl Validate for LowerBound {
+    /// The tree it finds the answers with, and the boxes it counts with.
+    fn validate(&self, prim_boxes: &[Aabb], clip: Option<ClipFn<'_>>) -> Result<StructureStats, InvalidStructure> {
+        if self.boxes != prim_boxes {
+            let e = super::brute::CountMismatch { built: self.boxes.len(), given: prim_boxes.len() };
+            return Err(InvalidStructure::new("lower bound", e));
+        }
+        self.bvh.validate(prim_boxes, clip)?;
+        Ok(self.stats())
     }
 }
 

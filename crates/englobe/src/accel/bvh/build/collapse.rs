@@ -10,8 +10,8 @@
 //!
 //! Every walk uses an explicit stack: a degenerate tree (a chain) is no problem.
 
-use super::layout::{BuildKind, BuildNode, BuildTree};
-use super::stats::{SAH_INTERSECTION_COST, SAH_TRAVERSAL_COST};
+use crate::accel::bvh::layout::{BuildKind, BuildNode, BuildTree};
+use crate::accel::bvh::stats::{SAH_INTERSECTION_COST, SAH_TRAVERSAL_COST};
 
 /// `tree` with every subtree of at most `max_leaf` primitives that costs less as a leaf collapsed
 /// into a leaf; the leaves' primitive references are reordered so that each leaf's are
@@ -100,7 +100,7 @@ mod tests {
 
     use super::*;
     use crate::Aabb;
-    use crate::accel::validate::validate_bvh;
+    use crate::accel::bvh::validate::validate_bvh;
 
     fn unit_at(x: f32) -> Aabb {
         Aabb::new(Vec3::new(x, 0.0, 0.0), Vec3::new(x + 1.0, 1.0, 1.0))

@@ -1,8 +1,8 @@
 //! Brute force: every ray is tested against every primitive. It is the "before" of every
 //! measurement and the oracle every other structure is checked against.
 
-use super::{Accel, Counters, Hit, HitRecord, StructureStats};
-use crate::shapes::PrimHit;
+use crate::PrimHit;
+use crate::accel::{Accel, ClipFn, Counters, Hit, HitRecord, InvalidStructure, StructureStats, Validate};
 use crate::{Aabb, Ray};
 
 /// Tests every primitive, in index order.
@@ -63,5 +63,24 @@ impl Accel for BruteForce {
             sah_cost: None,
             leaf_sizes: [0; crate::accel::LEAF_SIZE_BUCKETS],
         }
+    }
+}
+/// Brute force's one invariant: it tests every primitive.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("built over {built} primitives, checked against {given}")]
+pub struct CountMismatch {
+    /// Primitives it was built over.
+    pub built: usize,
+    /// Primitives it was checked against.
+    pub given: usize,
+}
+
+impl Validate for BruteForce {
+    fn validate(&self, prim_boxes: &[Aabb], _clip: Option<ClipFn<'_>>) -> Result<StructureStats, InvalidStructure> {
+        if self.count as usize != prim_boxes.len() {
+            let e = CountMismatch { built: self.count as usize, given: prim_boxes.len() };
+            return Err(InvalidStructure::new("brute force", e));
+        }
+        Ok(self.stats())
     }
 }

@@ -14,9 +14,9 @@
 //! Costs use [`SAH_TRAVERSAL_COST`] and [`SAH_INTERSECTION_COST`], like every other SAH measure
 //! here. Walks use explicit stacks, so degenerate (deep) trees are fine.
 
-use super::layout::{BuildKind, BuildTree};
-use super::stats::{SAH_INTERSECTION_COST, SAH_TRAVERSAL_COST};
 use crate::Aabb;
+use crate::accel::bvh::layout::{BuildKind, BuildTree};
+use crate::accel::bvh::stats::{SAH_INTERSECTION_COST, SAH_TRAVERSAL_COST};
 
 /// Leaves of a treelet: 7, as Karras and Aila chose (the subsets to score grow as `3^n`).
 pub const TREELET_LEAVES: usize = 7;
@@ -224,8 +224,8 @@ mod tests {
 
     use super::*;
     use crate::accel::bvh::layout::BuildNode;
-    use crate::accel::bvh::{Ploc, SeedPairing};
-    use crate::accel::validate::validate_bvh;
+    use crate::accel::bvh::validate::validate_bvh;
+    use crate::accel::{Ploc, SeedPairing};
 
     fn cube(c: Vec3, r: f32) -> Aabb {
         Aabb::new(c - Vec3::splat(r), c + Vec3::splat(r))
