@@ -13,6 +13,7 @@
 mod common;
 
 use common::load_obj;
+use common::rng::{in_cube, ray_into_box, seeded, unit_vec3};
 use englobe::accel::grid::stats::validate_grid_clipped;
 use englobe::accel::kdtree::stats::validate_kdtree;
 use englobe::accel::{Grid, GridParams, KdTree, KdTreeParams};
@@ -21,18 +22,12 @@ use englobe::{Aabb, Accel, AccelKind, AnyAccel, Ray, TriangleMesh, Vec3, WorkCou
 
 /// `n` random triangles of size `size` with centres in the cube `[-half, half]^3`.
 fn soup(n: usize, half: f32, size: f32) -> TriangleMesh {
-    let mut state = 0x9e37_79b9_7f4a_7c15u64;
-    let mut next = move || {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        (state >> 40) as f32 / (1u64 << 24) as f32
-    };
+    let mut rng = seeded(0x9e37_79b9_7f4a_7c15);
     let mut positions = Vec::with_capacity(3 * n);
     for _ in 0..n {
-        let c = Vec3::new(next(), next(), next()) * 2.0 * half - Vec3::splat(half);
+        let c = in_cube(&mut rng) * half;
         for _ in 0..3 {
-            positions.push(c + (Vec3::new(next(), next(), next()) - Vec3::splat(0.5)) * size);
+            positions.push(c + (unit_vec3(&mut rng) - Vec3::splat(0.5)) * size);
         }
     }
     let triangles = (0..n as u32).map(|i| [3 * i, 3 * i + 1, 3 * i + 2]).collect();
@@ -40,23 +35,8 @@ fn soup(n: usize, half: f32, size: f32) -> TriangleMesh {
 }
 
 fn rays_around(bounds: Aabb, count: usize) -> Vec<Ray> {
-    let mut state = 0x2545_f491_4f6c_dd1du64;
-    let mut next = move || {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        (state >> 40) as f32 / (1u64 << 24) as f32
-    };
-    let (centre, extent) = (bounds.center(), bounds.extent());
-    let radius = extent.length();
-    (0..count)
-        .map(|_| {
-            let dir = Vec3::new(next() - 0.5, next() - 0.5, next() - 0.5).normalize_or(Vec3::X);
-            let origin = centre + dir * radius;
-            let target = bounds.min + extent * Vec3::new(next(), next(), next());
-            Ray::new(origin, target - origin)
-        })
-        .collect()
+    let mut rng = seeded(0x2545_f491_4f6c_dd1d);
+    (0..count).map(|_| ray_into_box(&mut rng, &bounds)).collect()
 }
 
 fn work(accel: &impl Accel, mesh: &TriangleMesh, rays: &[Ray]) -> (f64, f64) {

@@ -9,6 +9,7 @@
 mod common;
 
 use common::check_all_structures_clipped;
+use common::rng::{Pcg32, RngExt, seeded};
 use englobe::shapes::clip_triangle;
 use englobe::{Aabb, Bounded, Intersect, PrimHit, Ray, Shape, Sphere, Triangle, Vec3};
 use proptest::prelude::*;
@@ -274,16 +275,17 @@ fn a_tie_in_a_subtree_entered_exactly_at_the_hit() {
     check(&shapes, &[ray]).unwrap();
 }
 
-/// A small deterministic generator for the exact-mode scenes (SplitMix64).
-struct Lattice(u64);
+/// The exact-mode scenes and rays, from the tests' generator.
+struct Lattice(Pcg32);
 
 impl Lattice {
+    fn new(seed: u64) -> Self {
+        Lattice(seeded(seed))
+    }
+
+    /// Uniform in `lo..=hi`.
     fn int(&mut self, lo: i32, hi: i32) -> i32 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        lo + ((z ^ (z >> 31)) % (hi - lo + 1) as u64) as i32
+        self.0.random_range(lo..=hi)
     }
 
     fn point(&mut self) -> Vec3 {
@@ -332,7 +334,7 @@ fn hit_set(accel: &englobe::AnyAccel, shapes: &[Shape], ray: &Ray) -> std::colle
 
 #[test]
 fn exact_mode_integer_scenes_and_axis_rays_find_the_same_sets_of_hit_primitives() {
-    let mut rng = Lattice(41);
+    let mut rng = Lattice::new(41);
     let mut compared = 0;
     for scene in 0..150 {
         let shapes = rng.scene(1 + scene % 40);
@@ -360,7 +362,7 @@ fn exact_mode_integer_scenes_and_axis_rays_find_the_same_sets_of_hit_primitives(
 fn every_size_from_0_to_64() {
     // Builds over the first n primitives of one scene, for every n: no panic, valid structures
     // (checked by the validators inside `check`), and the same answers as brute force.
-    let mut rng = Lattice(7);
+    let mut rng = Lattice::new(7);
     let shapes = rng.scene(64);
     let rays: Vec<Ray> = (0..24).map(|_| rng.axis_ray()).chain(star_rays()).collect();
     for n in 0..=64 {

@@ -7,9 +7,11 @@
 
 mod common;
 
+use common::rng::{seeded, unit_vec3};
 use common::{check_all_structures, load_obj};
 use englobe::accel::bvh::validate_bvh;
 use englobe::{Aabb, Accel, AccelKind, AnyAccel, Bounded, Intersect, Ray, Shape, Sphere, Triangle, TriangleMesh, Vec3};
+use rand::seq::SliceRandom;
 
 /// Most primitives per leaf of the SAH builders.
 const MAX_LEAF: usize = 8;
@@ -71,11 +73,7 @@ fn a_hundred_thousand_nested_spheres_with_one_centre() {
     check_shape(&boxes_of(&shapes), 128);
     let rays = rays_around(centre, 30.0);
     check_all_structures(&boxes_of(&shapes), &rays, |i, r| shapes[i as usize].intersect(r)).unwrap();
-    let mut state = 7u64;
-    for i in (1..shapes.len()).rev() {
-        state = state.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
-        shapes.swap(i, (state >> 33) as usize % (i + 1));
-    }
+    shapes.shuffle(&mut seeded(7));
     check_shape(&boxes_of(&shapes), 128);
 }
 
@@ -171,15 +169,11 @@ fn seventy_thousand_triangles_with_one_centroid() {
     // Triangles of every size and orientation around one point, whose centroid is that point.
     let centre = Vec3::new(-2.0, 0.5, 7.0);
     let mut positions = Vec::new();
-    let mut state = 0x2545_F491u64;
-    let mut next = || {
-        state = state.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
-        (state >> 40) as f32 / (1u64 << 24) as f32 - 0.5
-    };
+    let mut rng = seeded(0x2545_F491);
     for i in 0..70_000 {
         let scale = 0.01 + i as f32 * 1e-4;
-        let u = Vec3::new(next(), next(), next()) * scale;
-        let v = Vec3::new(next(), next(), next()) * scale;
+        let u = (unit_vec3(&mut rng) - 0.5) * scale;
+        let v = (unit_vec3(&mut rng) - 0.5) * scale;
         positions.extend([centre + u, centre + v, centre - u - v]);
     }
     let triangles = (0..70_000u32).map(|i| [3 * i, 3 * i + 1, 3 * i + 2]).collect();

@@ -6,6 +6,7 @@
 
 mod common;
 
+use common::rng::{ray_into_box, seeded};
 use common::{check_all_structures_clipped, load_obj};
 use englobe::accel::bvh::validate_bvh;
 use englobe::shapes::clip_triangle;
@@ -14,22 +15,10 @@ use englobe::{Aabb, Accel, AccelKind, AnyAccel, NoCount, Ray, Vec3, WorkCounts};
 /// Deterministic rays from a sphere around `bounds` towards points inside it, plus axis-parallel
 /// rays on a grid across it.
 fn rays_around(bounds: Aabb, count: usize) -> Vec<Ray> {
-    let mut state = 0x2545_f491_4f6c_dd1du64;
-    let mut next = move || {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        (state >> 40) as f32 / (1u64 << 24) as f32
-    };
-    let (centre, extent) = (bounds.center(), bounds.extent());
-    let radius = extent.length();
+    let mut rng = seeded(0x2545_f491_4f6c_dd1d);
+    let extent = bounds.extent();
     let mut rays = Vec::with_capacity(count + 108);
-    for _ in 0..count {
-        let dir = Vec3::new(next() - 0.5, next() - 0.5, next() - 0.5).normalize_or(Vec3::X);
-        let origin = centre + dir * radius;
-        let target = bounds.min + extent * Vec3::new(next(), next(), next());
-        rays.push(Ray::new(origin, target - origin));
-    }
+    rays.extend((0..count).map(|_| ray_into_box(&mut rng, &bounds)));
     for axis in 0..3 {
         for i in 0..6 {
             for j in 0..6 {

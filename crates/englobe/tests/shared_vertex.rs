@@ -7,26 +7,12 @@
 //! the box test keep these hits: switched off, the box of a triangle hit at the apex is rejected
 //! for some of the same rays.
 
+mod common;
+
+use common::rng::{in_cube, seeded};
 use englobe::accel::Isa;
 use englobe::geom::aabb::ROBUST_FAR_SCALE;
 use englobe::{Aabb, AccelKind, NoCount, Ray, TriangleBvh, TriangleMesh, Vec3, World};
-
-/// SplitMix64, so that failures reproduce.
-struct Rng(u64);
-
-impl Rng {
-    fn next_f32(&mut self) -> f32 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 40) as f32 / (1u64 << 24) as f32
-    }
-
-    fn in_cube(&mut self) -> Vec3 {
-        Vec3::new(self.next_f32(), self.next_f32(), self.next_f32()) * 2.0 - 1.0
-    }
-}
 
 /// A closed fan: `sides` triangles around the shared vertex `apex`, their far vertices on a
 /// circle in the plane z = apex.z (so the apex lies on the top or bottom face of every box), plus
@@ -61,10 +47,10 @@ fn fans() -> Vec<TriangleMesh> {
 fn rays_at_apex(mesh: &TriangleMesh, count: usize, seed: u64) -> Vec<Ray> {
     let apex = mesh.positions()[0];
     let reach = mesh.bounds().extent().max_element() * 4.0;
-    let mut rng = Rng(seed);
+    let mut rng = seeded(seed);
     (0..count)
         .map(|_| {
-            let origin = apex + rng.in_cube() * reach;
+            let origin = apex + in_cube(&mut rng) * reach;
             Ray::new(origin, apex - origin)
         })
         .filter(|r| r.is_valid())

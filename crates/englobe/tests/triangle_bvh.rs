@@ -7,6 +7,7 @@
 mod common;
 
 use common::load_obj;
+use common::rng::{in_box, in_cube, ray_into_box, seeded};
 use englobe::accel::wide::Isa;
 use englobe::shapes::{WatertightRay, intersect_triangle};
 use englobe::{Hit, NoCount, Ray, TriangleBvh, Vec3, WorkCounts};
@@ -219,22 +220,13 @@ fn stanford_bunny_in_every_instruction_set() {
     let tris: Vec<[Vec3; 3]> = (0..mesh.len() as u32).map(|i| mesh.triangle(i).vertices).collect();
     let bounds = mesh.bounds();
     let (centre, extent) = (bounds.center(), bounds.extent());
-    let mut state = 0x9e37_79b9_7f4a_7c15u64;
-    let mut next = move || {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        (state >> 40) as f32 / (1u64 << 24) as f32
-    };
+    let mut rng = seeded(0x9e37_79b9_7f4a_7c15);
     let mut rays = Vec::new();
     for _ in 0..1500 {
-        let dir = Vec3::new(next() - 0.5, next() - 0.5, next() - 0.5).normalize_or(Vec3::X);
-        let origin = centre + dir * extent.length();
-        let target = bounds.min + extent * Vec3::new(next(), next(), next());
-        rays.push(Ray::new(origin, target - origin));
+        rays.push(ray_into_box(&mut rng, &bounds));
         // Rays from inside the mesh's box, in every direction (some start inside the bunny).
-        let inside = bounds.min + extent * Vec3::new(next(), next(), next());
-        rays.push(Ray::new(inside, Vec3::new(next() - 0.5, next() - 0.5, next() - 0.5)));
+        let inside = in_box(&mut rng, &bounds);
+        rays.push(Ray::new(inside, in_cube(&mut rng) * 0.5));
     }
     for axis in 0..3 {
         for i in 0..10 {

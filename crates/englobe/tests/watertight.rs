@@ -9,8 +9,11 @@
 //! cell of the ideal sphere, so the triangle the ray really leaves through is always among them:
 //! a candidate set too small could only report a false miss, never hide one.
 
+mod common;
+
 use std::sync::Arc;
 
+use common::rng::{Pcg32, RngExt, seeded};
 use englobe::accel::Isa;
 use englobe::{AccelKind, Affine3A, Instance, NoCount, Object, Ray, TriangleBvh, TriangleMesh, Vec3, World};
 use glam::DVec3;
@@ -32,11 +35,11 @@ impl UvSphere {
     /// (the two poles are single vertices shared by a whole band).
     fn new(center: Vec3, radius: f32, bands: usize, sectors: usize, jitter: f64) -> Self {
         let c = center.as_dvec3();
-        let mut rng = Rng(0x5EED ^ (bands * sectors) as u64);
+        let mut rng = seeded(0x5EED ^ (bands * sectors) as u64);
         let mut point = |band: usize, sector: usize| -> Vec3 {
             let theta = std::f64::consts::PI * band as f64 / bands as f64;
             let phi = -std::f64::consts::PI + std::f64::consts::TAU * sector as f64 / sectors as f64;
-            let r = radius as f64 * (1.0 + jitter * (2.0 * rng.next_f64() - 1.0));
+            let r = radius as f64 * (1.0 + jitter * (2.0 * rng.random::<f64>() - 1.0));
             (c + DVec3::new(theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos()) * r).as_vec3()
         };
         let mut positions = vec![point(0, 0)];
@@ -105,23 +108,12 @@ impl UvSphere {
     }
 }
 
-/// xorshift64*: a small deterministic generator, so that failures reproduce.
-struct Rng(u64);
-
-impl Rng {
-    fn next_f64(&mut self) -> f64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        (self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 / (1u64 << 53) as f64
-    }
-
-    fn in_ball(&mut self) -> DVec3 {
-        loop {
-            let p = DVec3::new(self.next_f64(), self.next_f64(), self.next_f64()) * 2.0 - 1.0;
-            if p.length_squared() <= 1.0 && p.length_squared() > 1e-6 {
-                return p;
-            }
+/// Uniform in the unit ball, away from its centre (so that it can be normalised).
+fn in_ball(rng: &mut Pcg32) -> DVec3 {
+    loop {
+        let p = DVec3::new(rng.random(), rng.random(), rng.random()) * 2.0 - 1.0;
+        if p.length_squared() <= 1.0 && p.length_squared() > 1e-6 {
+            return p;
         }
     }
 }
@@ -133,10 +125,10 @@ fn random_rays_from_inside(sphere: &UvSphere, count: usize, seed: u64) -> usize 
 
 /// `count` rays from uniform points in the inner 90 % of the ball in uniform directions.
 fn random_rays(sphere: &UvSphere, count: usize, seed: u64) -> impl Iterator<Item = Ray> + '_ {
-    let mut rng = Rng(seed);
+    let mut rng = seeded(seed);
     (0..count).map(move |_| {
-        let origin = (sphere.center.as_dvec3() + rng.in_ball() * (0.9 * sphere.radius as f64)).as_vec3();
-        Ray::new(origin, rng.in_ball().normalize().as_vec3())
+        let origin = (sphere.center.as_dvec3() + in_ball(&mut rng) * (0.9 * sphere.radius as f64)).as_vec3();
+        Ray::new(origin, in_ball(&mut rng).normalize().as_vec3())
     })
 }
 
@@ -192,11 +184,11 @@ fn the_candidate_cells_do_hold_the_hit() {
     // Guard the test's own shortcut: on a coarser sphere, every triangle a ray hits is among its
     // candidates (so the tests above could only over-report misses).
     let sphere = UvSphere::new(FAR, 100.0, 24, 48, JITTER);
-    let mut rng = Rng(7);
+    let mut rng = seeded(7);
     let mut scratch = Vec::new();
     for _ in 0..20_000 {
-        let origin = (sphere.center.as_dvec3() + rng.in_ball() * 90.0).as_vec3();
-        let ray = Ray::new(origin, rng.in_ball().normalize().as_vec3());
+        let origin = (sphere.center.as_dvec3() + in_ball(&mut rng) * 90.0).as_vec3();
+        let ray = Ray::new(origin, in_ball(&mut rng).normalize().as_vec3());
         sphere.candidates(&ray, &mut scratch);
         for t in 0..sphere.mesh.len() as u32 {
             if sphere.mesh.intersect(t, &ray).is_some() {
@@ -213,10 +205,10 @@ fn rays_from_inside_an_instanced_sphere_never_miss() {
     let mesh = Arc::new(sphere.mesh);
     let place = Affine3A::from_scale_rotation_translation(Vec3::splat(100.0), glam::Quat::from_rotation_z(0.4), FAR);
     let world = World::build(vec![Instance::new(mesh, place).unwrap().into()], AccelKind::None).unwrap();
-    let mut rng = Rng(11);
+    let mut rng = seeded(11);
     for _ in 0..20_000 {
-        let origin = (FAR.as_dvec3() + rng.in_ball() * 90.0).as_vec3();
-        let ray = Ray::new(origin, rng.in_ball().normalize().as_vec3());
+        let origin = (FAR.as_dvec3() + in_ball(&mut rng) * 90.0).as_vec3();
+        let ray = Ray::new(origin, in_ball(&mut rng).normalize().as_vec3());
         assert!(world.closest_hit(&ray, &mut NoCount).is_some(), "{ray:?}");
         assert!(world.any_hit(&ray, &mut NoCount));
     }

@@ -110,6 +110,9 @@ fn step_f32(f: f32, up: bool) -> f32 {
 
 #[cfg(test)]
 mod tests {
+    use rand::{RngExt, SeedableRng};
+    use rand_pcg::Pcg32;
+
     use super::*;
 
     fn cube(min: f32, max: f32) -> Aabb {
@@ -152,13 +155,8 @@ mod tests {
     fn the_result_always_holds_sampled_points_of_the_triangle_in_the_cell() {
         // Awkward coordinates: the rounding outward must keep every point of the triangle that
         // lies in the cell.
-        let mut state = 0x9e37_79b9_u32;
-        let mut next = move || {
-            state ^= state << 13;
-            state ^= state >> 17;
-            state ^= state << 5;
-            state as f32 / u32::MAX as f32
-        };
+        let mut rng = Pcg32::seed_from_u64(0x9e37_79b9);
+        let mut next = move || rng.random::<f32>();
         for _ in 0..300 {
             let p = |n: &mut dyn FnMut() -> f32| Vec3::new(n() * 10.0 - 5.0, n() * 10.0 - 5.0, n() * 10.0 - 5.0);
             let v = [p(&mut next), p(&mut next), p(&mut next)];

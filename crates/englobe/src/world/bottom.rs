@@ -160,6 +160,8 @@ impl ClosestInstance {
 #[cfg(test)]
 mod tests {
     use glam::{Affine3A, Quat, Vec3};
+    use rand::{RngExt, SeedableRng};
+    use rand_pcg::Pcg32;
 
     use super::*;
     use crate::accel::{NoCount, WorkCounts};
@@ -240,13 +242,8 @@ mod tests {
         }
         let wi = World::build(instanced, AccelKind::None).unwrap();
         let wf = World::build(flat, AccelKind::None).unwrap();
-        let mut state = 0x2545_f491_u32;
-        let mut next = move || {
-            state ^= state << 13;
-            state ^= state >> 17;
-            state ^= state << 5;
-            state as f32 / u32::MAX as f32
-        };
+        let mut rng = Pcg32::seed_from_u64(0x2545_f491);
+        let mut next = move || rng.random::<f32>();
         let (mut hits, mut counts) = (0, WorkCounts::default());
         for _ in 0..4000 {
             let target = Vec3::new(next() * 16.0 - 8.0, next() * 6.0 - 2.0, 8.0 + next() * 8.0);

@@ -1,8 +1,11 @@
 //! Shared by the cross-structure tests: one check that runs every structure of
 //! [`AccelKind::ALL`] against brute force (the kd-tree both with the caller's clipping and with
-//! plain boxes), and the shared data folder and its meshes.
+//! plain boxes), the shared data folder and its meshes, and (in [`rng`]) the tests' random
+//! numbers.
 
 #![allow(dead_code)]
+
+pub mod rng;
 
 use std::path::PathBuf;
 

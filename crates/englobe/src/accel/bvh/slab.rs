@@ -81,6 +81,8 @@ impl RaySlabs {
 #[cfg(test)]
 mod tests {
     use glam::Vec3;
+    use rand::{RngExt, SeedableRng};
+    use rand_pcg::Pcg32;
 
     use super::*;
     use crate::Aabb;
@@ -89,13 +91,8 @@ mod tests {
     fn agrees_bit_for_bit_with_the_scalar_test() {
         // Integer coordinates and axis-parallel directions of both signs, zeros of both signs,
         // so that origins on planes, rays in faces and flat boxes all occur.
-        let mut s = 0x1234_5678u32;
-        let mut next = move |n: u32| {
-            s ^= s << 13;
-            s ^= s >> 17;
-            s ^= s << 5;
-            s % n
-        };
+        let mut rng = Pcg32::seed_from_u64(0x1234_5678);
+        let mut next = move |n: u32| rng.random_range(0..n);
         let values = [-2.0f32, -1.0, -0.0, 0.0, 0.5, 1.0, 2.0];
         let dirs = [-1.0f32, -0.0, 0.0, 0.3, 1.0];
         let mut hits = 0;

@@ -280,6 +280,8 @@ impl Builder<'_> {
 #[cfg(test)]
 mod tests {
     use glam::Vec3;
+    use rand::{RngExt, SeedableRng};
+    use rand_pcg::Pcg32;
 
     use super::*;
 
@@ -326,20 +328,15 @@ mod tests {
 
     #[test]
     fn the_sweep_finds_the_cheapest_plane_brute_force_finds() {
-        let mut state = 0x1234_5678_u32;
-        let mut next = move || {
-            state ^= state << 13;
-            state ^= state >> 17;
-            state ^= state << 5;
-            state
-        };
+        let mut rng = Pcg32::seed_from_u64(0x1234_5678);
+        let mut next = move |n: u32| rng.random_range(0..n);
         for round in 0..200 {
-            let n = 1 + (next() % 40) as usize;
+            let n = 1 + next(40) as usize;
             // Integer coordinates on a small lattice: shared positions and flat boxes are common.
             let boxes: Vec<Aabb> = (0..n)
                 .map(|_| {
-                    let a = Vec3::new((next() % 9) as f32, (next() % 9) as f32, (next() % 9) as f32);
-                    let b = Vec3::new((next() % 4) as f32, (next() % 4) as f32, (next() % 4) as f32);
+                    let a = Vec3::new(next(9) as f32, next(9) as f32, next(9) as f32);
+                    let b = Vec3::new(next(4) as f32, next(4) as f32, next(4) as f32);
                     // Some rounds have only flat boxes and points, some half-unit sizes.
                     Aabb::new(a, a + b * [1.0, 0.0, 0.5][round % 3])
                 })

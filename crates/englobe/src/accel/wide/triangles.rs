@@ -229,16 +229,15 @@ pub fn intersect_block(block: &TriBlock, r: &TriRay, t_max: f32) -> BlockHits {
 
 #[cfg(test)]
 mod tests {
+    use rand::{RngExt, SeedableRng};
+    use rand_pcg::Pcg32;
+
     use super::*;
 
-    /// xorshift32, so that failures reproduce.
-    fn rng(mut s: u32) -> impl FnMut() -> f32 {
-        move || {
-            s ^= s << 13;
-            s ^= s >> 17;
-            s ^= s << 5;
-            (s >> 8) as f32 / (1 << 24) as f32
-        }
+    /// Uniform numbers in `[0, 1)` from a seeded PCG32, so that failures reproduce.
+    fn rng(seed: u64) -> impl FnMut() -> f32 {
+        let mut rng = Pcg32::seed_from_u64(seed);
+        move || rng.random()
     }
 
     /// The lanes against the scalar test, lane by lane, special lanes resolved by it.

@@ -109,6 +109,8 @@ impl Splitter for SweepSah {
 #[cfg(test)]
 mod tests {
     use glam::Vec3;
+    use rand::{RngExt, SeedableRng};
+    use rand_pcg::Pcg32;
 
     use super::*;
     use crate::accel::bvh::BinnedSah;
@@ -120,13 +122,8 @@ mod tests {
 
     /// A deterministic cloud of boxes of mixed sizes.
     fn cloud(n: usize) -> Vec<Aabb> {
-        let mut s = 0x9e37_79b9u32;
-        let mut next = move || {
-            s ^= s << 13;
-            s ^= s >> 17;
-            s ^= s << 5;
-            (s >> 8) as f32 / (1u32 << 24) as f32
-        };
+        let mut rng = Pcg32::seed_from_u64(0x9e37_79b9);
+        let mut next = move || rng.random::<f32>();
         (0..n).map(|_| cube(Vec3::new(next(), next(), next()) * 100.0, 0.1 + next() * next() * 5.0)).collect()
     }
 

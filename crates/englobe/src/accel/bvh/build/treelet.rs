@@ -221,6 +221,8 @@ impl<W: Fn(&Aabb) -> f64> State<W> {
 #[cfg(test)]
 mod tests {
     use glam::Vec3;
+    use rand::{RngExt, SeedableRng};
+    use rand_pcg::Pcg32;
 
     use super::*;
     use crate::accel::bvh::layout::BuildNode;
@@ -232,13 +234,8 @@ mod tests {
     }
 
     fn cloud(n: usize) -> Vec<Aabb> {
-        let mut s = 0x2545_f491u32;
-        let mut next = move || {
-            s ^= s << 13;
-            s ^= s >> 17;
-            s ^= s << 5;
-            (s >> 8) as f32 / (1u32 << 24) as f32
-        };
+        let mut rng = Pcg32::seed_from_u64(0x2545_f491);
+        let mut next = move || rng.random::<f32>();
         (0..n).map(|_| cube(Vec3::new(next(), next(), next()) * 50.0, 0.2 + next() * 2.0)).collect()
     }
 
