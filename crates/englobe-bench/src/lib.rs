@@ -13,6 +13,7 @@ pub mod cli;
 pub mod library;
 pub mod measure;
 pub mod rays;
+pub mod registry;
 pub mod report;
 pub mod results;
 pub mod rng;
@@ -20,7 +21,8 @@ pub mod run;
 pub mod scene;
 
 pub use cli::BenchArgs;
-pub use library::{Library, LibraryKind, RayResult};
-pub use rays::{BenchRay, RaySetKind, RaySets};
+pub use library::{BenchRay, Library, RayResult};
+pub use rays::{RaySetKind, RaySets};
+pub use registry::{BuildSettings, LibraryKind, build_library};
 pub use run::run;
 pub use scene::BenchScene;
