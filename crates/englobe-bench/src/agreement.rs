@@ -20,8 +20,7 @@ use rayon::prelude::*;
 
 use englobe::{AccelKind, NoCount, Object, World};
 
-use crate::library::RayResult;
-use crate::rays::BenchRay;
+use crate::library::{BenchRay, RayResult};
 use crate::scene::BenchScene;
 
 /// Relative distance tolerance.

@@ -6,8 +6,8 @@ use clap::Args;
 
 use crate::adapters::englobe::EnglobeStructure;
 use crate::agreement::DEFAULT_MISMATCH_TOLERANCE;
-use crate::library::LibraryKind;
 use crate::rays::{DEFAULT_RAY_COUNT, DEFAULT_RESOLUTION, DEFAULT_SEED};
+use crate::registry::LibraryKind;
 use crate::report::Cell;
 use crate::scene::SceneSpec;
 

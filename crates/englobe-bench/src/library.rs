@@ -1,14 +1,39 @@
-//! A library under test: built from a scene, it answers closest-hit and any-hit queries for a
-//! slice of rays. Each library has one adapter in [`crate::adapters`]; this module names them and
-//! builds them.
+//! What the harness and a library under test share: the ray a library is given ([`BenchRay`]), the
+//! answer of a closest-hit query ([`RayResult`]) and the [`Library`] trait each adapter of
+//! `crate::adapters` implements. The bottom of the crate: it imports none of its other modules.
 
-use std::fmt;
-use std::str::FromStr;
+use englobe::Vec3;
 
-use crate::adapters;
-use crate::adapters::englobe::EnglobeStructure;
-use crate::rays::BenchRay;
-use crate::scene::BenchScene;
+/// One ray, as every library is given it: origin, direction, interval.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BenchRay {
+    /// Origin.
+    pub origin: Vec3,
+    /// Smallest parameter that counts as a hit.
+    pub t_min: f32,
+    /// Unit direction.
+    pub dir: Vec3,
+    /// Largest parameter that counts as a hit.
+    pub t_max: f32,
+}
+
+impl BenchRay {
+    /// A ray over `0..=inf`.
+    pub fn new(origin: Vec3, dir: Vec3) -> Self {
+        BenchRay { origin, t_min: 0.0, dir, t_max: f32::INFINITY }
+    }
+
+    /// The point at parameter `t`.
+    pub fn at(&self, t: f32) -> Vec3 {
+        self.origin + self.dir * t
+    }
+
+    /// The same ray as englobe's.
+    pub fn to_englobe(&self) -> englobe::Ray {
+        englobe::Ray::segment(self.origin, self.dir, self.t_min, self.t_max)
+    }
+}
 
 /// The answer of a closest-hit query: the hit distance and the triangle, or a miss.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -51,99 +76,4 @@ pub trait Library: Send + Sync {
     fn packet_width(&self) -> usize {
         1
     }
-}
-
-/// The libraries, by the names the CSV uses.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub enum LibraryKind {
-    /// Intel Embree 3, one ray at a time (`rtcIntersect1`, `rtcOccluded1`).
-    Embree,
-    /// Intel Embree 3, 16-ray packets (`rtcIntersect16`, `rtcOccluded16`).
-    EmbreePacket16,
-    /// englobe's structure under test.
-    Englobe,
-    /// obvhs 0.4, compressed wide BVH (CwBvh).
-    Obvhs,
-    /// bvh 0.13 (svenstaro/bvh).
-    Bvh,
-}
-
-impl LibraryKind {
-    /// Every library, in table order.
-    pub const ALL: [LibraryKind; 5] =
-        [LibraryKind::Embree, LibraryKind::EmbreePacket16, LibraryKind::Englobe, LibraryKind::Obvhs, LibraryKind::Bvh];
-
-    /// The name in tables and the CSV.
-    pub fn name(self) -> &'static str {
-        match self {
-            LibraryKind::Embree => "embree",
-            LibraryKind::EmbreePacket16 => "embree-packet16",
-            LibraryKind::Englobe => "englobe",
-            LibraryKind::Obvhs => "obvhs",
-            LibraryKind::Bvh => "bvh",
-        }
-    }
-
-    /// Whether this build can run it (Embree needs the `embree` feature).
-    pub fn available(self) -> bool {
-        cfg!(feature = "embree") || !matches!(self, LibraryKind::Embree | LibraryKind::EmbreePacket16)
-    }
-
-    /// The libraries this build can run, in table order.
-    pub fn available_kinds() -> Vec<LibraryKind> {
-        LibraryKind::ALL.into_iter().filter(|k| k.available()).collect()
-    }
-}
-
-impl fmt::Display for LibraryKind {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl FromStr for LibraryKind {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        let kind = LibraryKind::ALL.into_iter().find(|k| k.name() == s).ok_or_else(|| {
-            let names: Vec<_> = LibraryKind::ALL.iter().map(|k| k.name()).collect();
-            format!("unknown library `{s}`; expected one of: {}", names.join(", "))
-        })?;
-        if !kind.available() {
-            return Err(format!("`{s}` needs the `embree` cargo feature (and Debian's libembree-dev)"));
-        }
-        Ok(kind)
-    }
-}
-
-/// How to build the libraries.
-#[derive(Clone, Copy, Debug)]
-pub struct BuildSettings {
-    /// Threads the build may use (the harness also runs it inside a pool of this size).
-    pub threads: usize,
-    /// englobe's structure.
-    pub englobe: EnglobeStructure,
-    /// Build Embree's scene with `RTC_SCENE_FLAG_ROBUST` (off by default).
-    pub embree_robust: bool,
-}
-
-/// Builds library `kind` over the scene's triangles. Call it inside the thread pool the
-/// measurement uses, so that builders parallelised with rayon use that many threads.
-pub fn build_library(
-    kind: LibraryKind,
-    scene: &BenchScene,
-    settings: &BuildSettings,
-) -> anyhow::Result<Box<dyn Library>> {
-    Ok(match kind {
-        LibraryKind::Englobe => Box::new(adapters::englobe::EnglobeLibrary::build(scene, settings.englobe)?),
-        LibraryKind::Obvhs => Box::new(adapters::obvhs::ObvhsLibrary::build(scene)),
-        LibraryKind::Bvh => Box::new(adapters::bvh::BvhLibrary::build(scene)),
-        #[cfg(feature = "embree")]
-        LibraryKind::Embree => Box::new(adapters::embree::EmbreeSingle::build(scene, settings)?),
-        #[cfg(feature = "embree")]
-        LibraryKind::EmbreePacket16 => Box::new(adapters::embree::EmbreePacket16::build(scene, settings)?),
-        #[cfg(not(feature = "embree"))]
-        LibraryKind::Embree | LibraryKind::EmbreePacket16 => {
-            anyhow::bail!("{kind} needs the `embree` cargo feature (and Debian's libembree-dev)")
-        }
-    })
 }

@@ -6,8 +6,7 @@ use std::time::Instant;
 
 use rayon::prelude::*;
 
-use crate::library::{Library, RayResult};
-use crate::rays::BenchRay;
+use crate::library::{BenchRay, Library, RayResult};
 
 /// Rays per task handed to a thread (a multiple of every packet width).
 pub const CHUNK: usize = 1024;

@@ -27,7 +27,7 @@ use std::f32::consts::PI;
 
 use englobe::Vec3;
 
-use crate::library::RayResult;
+use crate::library::{BenchRay, RayResult};
 use crate::rng::SplitMix64;
 use crate::scene::BenchScene;
 
@@ -43,37 +43,6 @@ pub const DEFAULT_SEED: u64 = 2009;
 pub const BLOCK: u32 = 4;
 /// How far bounce rays leave the surface, relative to the scene's size and position.
 pub const BOUNCE_OFFSET: f32 = 1e-4;
-
-/// One ray, as every library is given it: origin, direction, interval.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct BenchRay {
-    /// Origin.
-    pub origin: Vec3,
-    /// Smallest parameter that counts as a hit.
-    pub t_min: f32,
-    /// Unit direction.
-    pub dir: Vec3,
-    /// Largest parameter that counts as a hit.
-    pub t_max: f32,
-}
-
-impl BenchRay {
-    /// A ray over `0..=inf`.
-    pub fn new(origin: Vec3, dir: Vec3) -> Self {
-        BenchRay { origin, t_min: 0.0, dir, t_max: f32::INFINITY }
-    }
-
-    /// The point at parameter `t`.
-    pub fn at(&self, t: f32) -> Vec3 {
-        self.origin + self.dir * t
-    }
-
-    /// The same ray as englobe's.
-    pub fn to_englobe(&self) -> englobe::Ray {
-        englobe::Ray::segment(self.origin, self.dir, self.t_min, self.t_max)
-    }
-}
 
 /// The three sets.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]

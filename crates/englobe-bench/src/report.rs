@@ -5,9 +5,9 @@
 
 use std::fmt::Write as _;
 
-use crate::library::LibraryKind;
 use crate::measure::Query;
 use crate::rays::RaySetKind;
+use crate::registry::LibraryKind;
 use crate::results::Measurement;
 
 /// A column of the table: a ray set and a query.

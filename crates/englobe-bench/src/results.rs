@@ -8,9 +8,9 @@ use std::path::Path;
 
 use anyhow::Context;
 
-use crate::library::LibraryKind;
 use crate::measure::Query;
 use crate::rays::RaySetKind;
+use crate::registry::LibraryKind;
 
 /// One measured cell.
 #[derive(Clone, Debug, PartialEq)]

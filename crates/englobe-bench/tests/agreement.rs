@@ -4,9 +4,9 @@
 use std::path::Path;
 
 use englobe_bench::agreement::{self, DEFAULT_MISMATCH_TOLERANCE, Reference};
-use englobe_bench::library::{BuildSettings, build_library};
 use englobe_bench::measure::{Answers, Query, thread_pool, trace};
 use englobe_bench::rays::{RayParams, RaySetKind};
+use englobe_bench::registry::{BuildSettings, build_library};
 use englobe_bench::run::generate_rays;
 use englobe_bench::{BenchRay, BenchScene, Library, LibraryKind, RayResult, RaySets};
 use englobe_scene::shared_data::shared_meshes_or_panic;

@@ -82,6 +82,20 @@ fn a_small_run_writes_the_csv_and_names_it_last() {
 }
 
 #[test]
+fn two_libraries_on_one_thread_write_four_rows_each() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("bench.csv");
+    let box_ = cornell_box();
+    let args = [box_.as_str(), "--resolution", "16", "--rays", "256", "--reps", "1", "--threads", "1"];
+    let out = bench(&[&args[..], &["--libraries", "englobe,obvhs", "-q", "-o", csv.to_str().unwrap()]].concat());
+    let stdout = text(&out.stdout);
+    assert!(out.status.success(), "{stdout}\n{}", text(&out.stderr));
+    assert_eq!(stdout.lines().last().unwrap(), csv.to_str().unwrap());
+    let written = std::fs::read_to_string(&csv).unwrap();
+    assert_eq!(written.lines().count(), 1 + 2 * 4, "{written}");
+}
+
+#[test]
 fn bad_input_is_refused_with_a_clear_error() {
     let missing = bench(&["no/such/mesh.obj", "-q"]);
     assert_eq!(missing.status.code(), Some(2));

@@ -5,7 +5,6 @@
 
 use englobe::{TriangleMesh, Vec3};
 use englobe_bench::adapters::embree::{EmbreePacket16, EmbreeSingle};
-use englobe_bench::library::BuildSettings;
 use englobe_bench::{BenchRay, BenchScene, Library, RayResult};
 
 /// Two unit squares facing +z, at z = 0 (triangles 0 and 1) and z = -1 (triangles 2 and 3).
@@ -73,11 +72,10 @@ fn single_rays_and_packets_answer_right() {
     let scene = two_squares();
     for robust in [false, true] {
         for threads in [1, 2] {
-            let settings = BuildSettings { threads, englobe: Default::default(), embree_robust: robust };
-            let single = EmbreeSingle::build(&scene, &settings).unwrap();
+            let single = EmbreeSingle::build(&scene, threads, robust).unwrap();
             assert!(single.structure().contains("Embree 3."), "{}", single.structure());
             check(&single);
-            let packets = EmbreePacket16::build(&scene, &settings).unwrap();
+            let packets = EmbreePacket16::build(&scene, threads, robust).unwrap();
             assert_eq!(packets.packet_width(), 16);
             check(&packets);
         }

@@ -1,17 +1,15 @@
 //! The `englobe` command: render scenes, measure how acceleration structures cut the work of ray
-//! tracing, and benchmark englobe against other libraries (`bench`, forwarded to englobe-bench).
+//! tracing (the experiments and comparisons of englobe-lab), and benchmark englobe against other
+//! libraries (`bench`, forwarded to englobe-bench when built with the `bench` feature). Each
+//! command's file parses its arguments and calls the library crates.
 
+mod bench_cmd;
 mod compare_cmd;
 mod experiment_cmd;
 mod info_cmd;
 mod interrupt;
-mod measure;
-mod memory;
-mod plot;
 mod progress;
 mod render_cmd;
-mod report;
-mod seed_report;
 
 use std::process::ExitCode;
 
@@ -34,10 +32,10 @@ enum Command {
     Experiment(experiment_cmd::ExperimentArgs),
     /// Build every accelerator for one scene and compare build time, memory, speed and work.
     Compare(compare_cmd::CompareArgs),
-    /// Measure englobe against Intel Embree, obvhs and bvh on the same rays (Embree with the
-    /// `embree` cargo feature); prints a table per scene and thread count, writes a CSV and prints
-    /// its path last.
-    Bench(englobe_bench::BenchArgs),
+    /// Measure englobe against Intel Embree, obvhs and bvh on the same rays (needs the `bench`
+    /// cargo feature, Embree the `embree` one; otherwise run the englobe-bench binary); prints a
+    /// table per scene and thread count, writes a CSV and prints its path last.
+    Bench(bench_cmd::BenchArgs),
     /// Say what a mesh file (.obj, .ply, .gltf, .glb) or a scene file (.toml) holds, or why it is
     /// refused.
     Info(info_cmd::InfoArgs),
@@ -50,7 +48,7 @@ fn main() -> ExitCode {
         Command::Experiment(args) => experiment_cmd::run(args),
         Command::Compare(args) => compare_cmd::run(args),
         Command::Info(args) => info_cmd::run(args),
-        Command::Bench(args) => englobe_bench::run(&args),
+        Command::Bench(args) => bench_cmd::run(args),
     };
     match result {
         Ok(code) => code,

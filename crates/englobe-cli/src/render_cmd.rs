@@ -7,13 +7,13 @@ use std::time::Instant;
 use anyhow::Context;
 use clap::{Args, ValueEnum};
 use englobe::AccelKind;
+use englobe_lab::memory::peak_rss_bytes;
+use englobe_lab::report::{StatsReport, stats_table, write_json};
 use englobe_render::{HeatmapScale, Renderer, build_world, write_cost_image, write_image};
 use englobe_scene::{IntegratorKind, Scene, load_scene, parse_scene};
 
 use crate::interrupt;
-use crate::memory::peak_rss_bytes;
 use crate::progress::tile_bar;
-use crate::report::{StatsReport, stats_table, write_json};
 
 #[derive(Args)]
 pub struct RenderArgs {

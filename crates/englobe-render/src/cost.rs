@@ -67,7 +67,9 @@ pub fn write_cost_image(cost: &CostImage, path: &Path, scale: HeatmapScale) -> R
     let format = OutputFormat::from_path(path)?;
     write_atomically(path, |w| {
         let result = match format {
-            OutputFormat::Png => Heatmap::new(cost, scale).to_rgb8().write_to(w, ImageFormat::Png),
+            OutputFormat::Png => {
+                Heatmap::new(cost.width(), cost.height(), cost.values(), scale).to_rgb8().write_to(w, ImageFormat::Png)
+            }
             OutputFormat::Exr => {
                 let raw = cost.values().iter().flat_map(|&v| [v as f32; 3]).collect();
                 Rgb32FImage::from_raw(cost.width(), cost.height(), raw)

@@ -1,5 +1,6 @@
-//! False colour for the cost AOV: each pixel's work mapped through the viridis colormap, with a
-//! colour bar and its end values drawn below the image.
+//! False colour for the cost AOV: a grid of counts (each pixel's work) mapped through the viridis
+//! colormap, with a colour bar and its end values drawn below the image. It sees only the counts,
+//! row by row; the cost image that holds them is [`crate::cost`]'s.
 //!
 //! Viridis is the perceptually uniform colormap of van der Walt, Smith and Firing (2015), designed
 //! for matplotlib ("A Better Default Colormap for Matplotlib", SciPy 2015) and released under CC0;
@@ -9,8 +10,6 @@
 //! `position = ln(1 + cost) / ln(1 + max)`.
 
 use image::{Rgb, RgbImage};
-
-use crate::cost::CostImage;
 
 /// Entries 0, 16, 32, ..., 240 and 255 of matplotlib's viridis table (sRGB, 0..=1).
 const VIRIDIS: [(u8, [f32; 3]); 17] = [
@@ -90,9 +89,12 @@ impl HeatmapScale {
     }
 }
 
-/// A cost image in false colour.
+/// A grid of costs in false colour.
 pub struct Heatmap<'a> {
-    cost: &'a CostImage,
+    width: u32,
+    height: u32,
+    /// `width * height` costs, row by row from the top.
+    values: &'a [u64],
     scale: HeatmapScale,
 }
 
@@ -111,15 +113,20 @@ const DIGITS: [[u8; 5]; 10] = [
 ];
 
 impl<'a> Heatmap<'a> {
-    /// The heatmap of `cost` on `scale`.
-    pub fn new(cost: &'a CostImage, scale: HeatmapScale) -> Self {
-        Heatmap { cost, scale }
+    /// The heatmap of the `width` x `height` costs `values` (row by row from the top) on `scale`.
+    ///
+    /// # Panics
+    ///
+    /// If `values` does not hold exactly `width * height` costs.
+    pub fn new(width: u32, height: u32, values: &'a [u64], scale: HeatmapScale) -> Self {
+        assert_eq!(values.len(), width as usize * height as usize, "a {width}x{height} heatmap needs as many costs");
+        Heatmap { width, height, values, scale }
     }
 
     /// The image: the cost in false colour, then below it a colour bar from 0 to the scale's
     /// maximum, with the values at its ends (and middle, where they fit) written under it.
     pub fn to_rgb8(&self) -> RgbImage {
-        let (w, h) = (self.cost.width(), self.cost.height());
+        let (w, h) = (self.width, self.height);
         let glyph = if w >= 256 { 2 } else { 1 };
         let pad = 2 * glyph;
         let bar_height = (h / 20).clamp(6, 24);
@@ -128,7 +135,8 @@ impl<'a> Heatmap<'a> {
         let mut img = RgbImage::new(w, total);
         for y in 0..h {
             for x in 0..w {
-                img.put_pixel(x, y, Rgb(viridis(self.scale.position(self.cost.get(x, y)))));
+                let cost = self.values[y as usize * w as usize + x as usize];
+                img.put_pixel(x, y, Rgb(viridis(self.scale.position(cost))));
             }
         }
         let (x0, x1) = if w > 2 * pad { (pad, w - pad) } else { (0, w) };
@@ -226,9 +234,9 @@ mod tests {
 
     #[test]
     fn the_bar_runs_from_dark_to_bright_under_the_image() {
-        let mut cost = CostImage::new(300, 200);
-        cost.set(10, 10, 4000);
-        let img = Heatmap::new(&cost, HeatmapScale::log(cost.max())).to_rgb8();
+        let mut cost = vec![0; 300 * 200];
+        cost[10 * 300 + 10] = 4000;
+        let img = Heatmap::new(300, 200, &cost, HeatmapScale::log(4000)).to_rgb8();
         assert_eq!(img.get_pixel(10, 10).0, viridis(1.0));
         assert_eq!(img.get_pixel(0, 0).0, viridis(0.0));
         let bar_y = 200 + 4 + 2;
@@ -241,8 +249,7 @@ mod tests {
 
     #[test]
     fn tiny_images_get_a_bar_without_labels() {
-        let cost = CostImage::new(3, 2);
-        let img = Heatmap::new(&cost, HeatmapScale::log(123_456)).to_rgb8();
+        let img = Heatmap::new(3, 2, &[0; 6], HeatmapScale::log(123_456)).to_rgb8();
         assert_eq!(img.width(), 3);
         assert!(img.pixels().all(|p| p.0 != [255, 255, 255]));
     }

@@ -1,5 +1,5 @@
-//! End-to-end rendering: determinism across thread counts, exact optics checks, and a pixel whose
-//! colour can be computed by hand.
+//! End-to-end rendering: determinism across thread counts, exact optics checks, a pixel whose
+//! colour can be computed by hand, the cost AOV and rendering a regular sample of the pixels.
 
 use englobe::{AccelKind, Vec3};
 use englobe_render::film::encode_srgb8;
@@ -211,4 +211,34 @@ fn absurd_sizes_are_refused_before_rendering() {
     assert!(Renderer::new(&s, &world).size(0, 10).render().is_err());
     assert!(Renderer::new(&s, &world).size(1 << 20, 1 << 20).render().is_err());
     assert!(Renderer::new(&s, &world).samples(0).render().is_err());
+}
+
+#[test]
+fn cost_is_recorded_only_when_asked_and_adds_up_to_the_counts() {
+    let scene = scene(DEFAULT_SCENE);
+    let world = build_world(&scene, AccelKind::BvhSeedOrdered).unwrap();
+    let plain = Renderer::new(&scene, &world).size(40, 30).samples(1).render().unwrap();
+    assert!(plain.cost.is_none());
+    let out = Renderer::new(&scene, &world).size(40, 30).samples(1).record_cost(true).render().unwrap();
+    let cost = out.cost.expect("recorded");
+    let total = out.stats.total();
+    assert_eq!(cost.total(), total.nodes_visited + total.exact_tests);
+    assert!(cost.values().iter().all(|&c| c > 0), "every pixel tests at least the plane");
+    assert_eq!(out.film, plain.film, "recording the cost does not change the image");
+}
+
+#[test]
+fn a_pixel_stride_renders_the_same_pixels_and_only_them() {
+    let scene = scene(DEFAULT_SCENE);
+    let world = build_world(&scene, AccelKind::None).unwrap();
+    let full = Renderer::new(&scene, &world).size(37, 29).count_work(true).render().unwrap();
+    let sample = Renderer::new(&scene, &world).size(37, 29).count_work(true).pixel_stride(4).render().unwrap();
+    for y in 0..29 {
+        for x in 0..37 {
+            let expected = if x % 4 == 0 && y % 4 == 0 { full.film.get(x, y) } else { Vec3::ZERO };
+            assert_eq!(sample.film.get(x, y), expected, "pixel ({x}, {y})");
+        }
+    }
+    let primary = sample.stats.kind(RayKind::Primary).rays;
+    assert_eq!(primary, 10 * 8 * scene.image.samples as u64);
 }

@@ -12,8 +12,7 @@ use englobe::Vec3;
 use nalgebra::{Point3, Vector3};
 
 use super::moller_trumbore;
-use crate::library::{Library, RayResult};
-use crate::rays::BenchRay;
+use crate::library::{BenchRay, Library, RayResult};
 use crate::scene::BenchScene;
 
 /// A triangle as the crate wants its shapes: bounded and told its node.

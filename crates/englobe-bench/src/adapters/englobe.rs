@@ -13,8 +13,7 @@ use std::fmt;
 use englobe::accel::wide::Isa;
 use englobe::{AccelKind, NoCount, Object, TriangleBvh, World};
 
-use crate::library::{Library, RayResult};
-use crate::rays::BenchRay;
+use crate::library::{BenchRay, Library, RayResult};
 use crate::scene::BenchScene;
 
 /// The structures englobe can be measured with, best first: the default is the first one this

@@ -13,8 +13,7 @@ use obvhs::cwbvh::builder::build_cwbvh_from_tris;
 use obvhs::ray::{Ray, RayHit};
 use obvhs::triangle::Triangle;
 
-use crate::library::{Library, RayResult};
-use crate::rays::BenchRay;
+use crate::library::{BenchRay, Library, RayResult};
 use crate::scene::BenchScene;
 
 /// obvhs, built.

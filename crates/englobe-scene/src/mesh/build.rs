@@ -8,7 +8,7 @@ use std::path::Path;
 use englobe::{TriangleMesh, Vec2, Vec3};
 
 use super::error::{MeshErrorKind, MeshFileError};
-use super::{LoadedMesh, MeshFormat, NO_MATERIAL, NamedMaterial};
+use super::loaded::{LoadedMesh, MeshFormat, NO_MATERIAL, NamedMaterial};
 
 /// A mesh as a loader produced it, before the common checks.
 #[derive(Debug, Default)]

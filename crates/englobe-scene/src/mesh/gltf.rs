@@ -22,7 +22,8 @@ use gltf::json::validation::Checked;
 use super::build::{MeshParts, finish};
 use super::error::{MeshErrorKind, MeshFileError, Position};
 use super::gltf_data::Buffers;
-use super::{LoadedMesh, MeshFormat, NO_MATERIAL, NamedMaterial, guarded};
+use super::loaded::{LoadedMesh, MeshFormat, NO_MATERIAL, NamedMaterial};
+use super::read::guarded;
 use crate::model::Material;
 
 /// Most node instances a scene may expand to (a node reachable along many paths counts once per

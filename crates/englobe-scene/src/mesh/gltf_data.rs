@@ -14,7 +14,8 @@ use gltf::json;
 use gltf::json::accessor::{ComponentType, Type};
 
 use super::error::{MeshErrorKind, MeshFileError, Position};
-use super::{MAX_MESH_FILE_BYTES, read_limited};
+use super::loaded::MAX_MESH_FILE_BYTES;
+use super::read::read_limited;
 
 /// The buffers of a document, loaded when first used.
 pub(super) struct Buffers<'a> {

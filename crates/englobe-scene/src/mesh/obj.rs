@@ -14,8 +14,10 @@ use englobe::{Vec2, Vec3};
 
 use super::build::{MeshParts, finish};
 use super::error::{MeshErrorKind, MeshFileError};
+use super::loaded::{LoadedMesh, MAX_MTL_FILE_BYTES, MeshFormat, NO_MATERIAL};
+use super::read::{guarded, read_limited, utf8_text};
 use super::triangulate::triangulate;
-use super::{LoadedMesh, MAX_MTL_FILE_BYTES, MeshFormat, NO_MATERIAL, guarded, mtl, obj_scan, read_limited, utf8_text};
+use super::{mtl, obj_scan};
 
 /// Material libraries read while `tobj` parses, and what went wrong with them.
 #[derive(Default)]

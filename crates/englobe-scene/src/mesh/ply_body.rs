@@ -7,7 +7,7 @@ use std::path::Path;
 use englobe::{Vec2, Vec3};
 
 use super::error::{MeshErrorKind, MeshFileError, Position};
-use super::ply::{Encoding, Header, Property, Scalar};
+use super::ply_header::{Encoding, Header, Property, Scalar};
 
 /// What englobe keeps of a PLY body.
 #[derive(Debug, Default)]

@@ -13,8 +13,7 @@ use std::sync::{Arc, Mutex};
 
 use anyhow::{Context, bail};
 
-use crate::library::{BuildSettings, Library, RayResult};
-use crate::rays::BenchRay;
+use crate::library::{BenchRay, Library, RayResult};
 use crate::scene::BenchScene;
 use ffi::*;
 
@@ -151,9 +150,9 @@ impl Drop for EmbreeScene {
 pub struct EmbreeSingle(EmbreeScene);
 
 impl EmbreeSingle {
-    /// Builds the scene.
-    pub fn build(scene: &BenchScene, settings: &BuildSettings) -> anyhow::Result<Self> {
-        EmbreeScene::build(scene, settings.threads, settings.embree_robust).map(EmbreeSingle).context("Embree")
+    /// Builds the scene on `threads` threads, with `RTC_SCENE_FLAG_ROBUST` if `robust`.
+    pub fn build(scene: &BenchScene, threads: usize, robust: bool) -> anyhow::Result<Self> {
+        EmbreeScene::build(scene, threads, robust).map(EmbreeSingle).context("Embree")
     }
 }
 
@@ -211,9 +210,9 @@ impl Library for EmbreeSingle {
 pub struct EmbreePacket16(EmbreeScene);
 
 impl EmbreePacket16 {
-    /// Builds the scene.
-    pub fn build(scene: &BenchScene, settings: &BuildSettings) -> anyhow::Result<Self> {
-        EmbreeScene::build(scene, settings.threads, settings.embree_robust).map(EmbreePacket16).context("Embree")
+    /// Builds the scene on `threads` threads, with `RTC_SCENE_FLAG_ROBUST` if `robust`.
+    pub fn build(scene: &BenchScene, threads: usize, robust: bool) -> anyhow::Result<Self> {
+        EmbreeScene::build(scene, threads, robust).map(EmbreePacket16).context("Embree")
     }
 }
 

@@ -1,37 +1,53 @@
-//! Printing what a render counted: a table for people, JSON for programs.
+//! Reports for people and for programs: what a render counted (the table of `--stats`, the JSON
+//! of `--stats-json`), any report written as JSON, and numbers written the way the tables write
+//! them (digits in groups of three, bytes in binary units).
 
 use std::path::Path;
 
-use anyhow::Context;
 use englobe_render::{KindStats, RayKind, RenderStats};
 use serde::Serialize;
+
+use crate::error::LabError;
 
 /// Everything `--stats-json` writes.
 #[derive(Serialize)]
 pub struct StatsReport<'a> {
+    /// The scene's file, or `default`.
     pub scene: &'a str,
+    /// The structure's name.
     pub accel: &'a str,
+    /// Image width.
     pub width: u32,
+    /// Image height.
     pub height: u32,
+    /// Samples per pixel.
     pub samples: u32,
+    /// Seconds to build the world.
     pub build_seconds: f64,
+    /// Seconds to render.
     pub render_seconds: f64,
     /// Triangles in the picture (every instance counting its mesh's).
     pub triangles: usize,
     /// Peak resident memory of the process, where the system reports it.
     pub peak_memory_bytes: Option<u64>,
+    /// One row per kind of ray.
     pub kinds: Vec<KindRow>,
+    /// All kinds together.
     pub total: KindStats,
 }
 
+/// What the rays of one kind counted.
 #[derive(Serialize)]
 pub struct KindRow {
+    /// The kind of ray.
     pub kind: RayKind,
+    /// Its counts.
     #[serde(flatten)]
     pub stats: KindStats,
 }
 
 impl<'a> StatsReport<'a> {
+    /// The rows of `stats`, one per kind of ray, in [`RayKind::ALL`]'s order.
     pub fn rows(stats: &RenderStats) -> Vec<KindRow> {
         RayKind::ALL.iter().map(|&kind| KindRow { kind, stats: *stats.kind(kind) }).collect()
     }
@@ -58,8 +74,8 @@ pub fn stats_table(stats: &RenderStats) -> String {
 }
 
 /// Writes `value` as pretty JSON to `path`, atomically.
-pub fn write_json(path: &Path, value: &impl Serialize) -> anyhow::Result<()> {
-    let text = serde_json::to_string_pretty(value).context("cannot serialise the statistics")?;
+pub fn write_json(path: &Path, value: &impl Serialize) -> Result<(), LabError> {
+    let text = serde_json::to_string_pretty(value).map_err(LabError::Serialise)?;
     englobe_render::output::write_atomically(path, |w| {
         use std::io::Write;
         w.write_all(text.as_bytes())

@@ -1,12 +1,14 @@
-//! What `experiment` and `compare` share: building one structure for a scene and rendering with
-//! it, timed, and comparing the images of two structures.
+//! What the seed's experiments and the comparison share: building one structure for a scene and
+//! rendering with it, timed, comparing the images of two structures bit for bit, and the worker
+//! pool they render on.
 
 use std::time::Instant;
 
-use anyhow::Context;
 use englobe::{AccelKind, World};
 use englobe_render::{Film, RenderOutput, Renderer, build_world};
 use englobe_scene::Scene;
+
+use crate::error::LabError;
 
 /// Renders are repeated until they have taken this long in all (or [`MAX_TIMED_RUNS`] times), and
 /// the best time is kept.
@@ -31,14 +33,14 @@ pub struct RenderSettings {
 
 /// Builds the world of the scene's objects under `kind`; returns it with the seconds it took
 /// (the primitives' boxes and the structure over them).
-pub fn build(scene: &Scene, kind: AccelKind) -> anyhow::Result<(World, f64)> {
+pub fn build(scene: &Scene, kind: AccelKind) -> Result<(World, f64), LabError> {
     let start = Instant::now();
-    let world = build_world(scene, kind).with_context(|| format!("cannot build {kind}"))?;
+    let world = build_world(scene, kind).map_err(|source| LabError::Build { kind, source })?;
     Ok((world, start.elapsed().as_secs_f64()))
 }
 
 /// Renders the scene through `world` on the current pool.
-pub fn render(scene: &Scene, world: &World, settings: RenderSettings) -> anyhow::Result<RenderOutput> {
+pub fn render(scene: &Scene, world: &World, settings: RenderSettings) -> Result<RenderOutput, LabError> {
     Ok(Renderer::new(scene, world)
         .size(settings.width, settings.height)
         .samples(settings.samples)
@@ -65,9 +67,6 @@ pub fn compare_films(a: &Film, stride_a: u32, b: &Film, stride_b: u32) -> (usize
 }
 
 /// A worker pool of `threads` threads (all cores if `None`).
-pub fn thread_pool(threads: Option<u32>) -> anyhow::Result<rayon::ThreadPool> {
-    rayon::ThreadPoolBuilder::new()
-        .num_threads(threads.map_or(0, |t| t as usize))
-        .build()
-        .context("cannot start the worker threads")
+pub fn thread_pool(threads: Option<u32>) -> Result<rayon::ThreadPool, LabError> {
+    rayon::ThreadPoolBuilder::new().num_threads(threads.map_or(0, |t| t as usize)).build().map_err(LabError::Threads)
 }

@@ -1,5 +1,5 @@
-//! `compare --plot FILE.svg`: the comparison as a picture, written as SVG by hand (a few rectangles
-//! and labels need no plotting library). Two panels share the structures' rows: rays per second
+//! The comparison as a picture (`englobe compare --plot FILE.svg`), written as SVG by hand (a few
+//! rectangles and labels need no plotting library). Two panels share the structures' rows: rays per second
 //! and exact tests per ray, each a horizontal bar per structure on a logarithmic axis, since brute
 //! force sits orders of magnitude away from every structure on both. Each bar is labelled with its
 //! value, so that the picture can be read without the table.
@@ -7,7 +7,7 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use anyhow::Context;
+use crate::error::LabError;
 
 /// What one bar pair shows.
 #[derive(Clone, Debug, PartialEq)]
@@ -166,13 +166,13 @@ pub fn svg(title: &str, subtitle: &str, rows: &[PlotRow]) -> String {
 }
 
 /// Writes the SVG to `path`, atomically.
-pub fn write_svg(path: &Path, title: &str, subtitle: &str, rows: &[PlotRow]) -> anyhow::Result<()> {
+pub fn write_svg(path: &Path, title: &str, subtitle: &str, rows: &[PlotRow]) -> Result<(), LabError> {
     let text = svg(title, subtitle, rows);
     englobe_render::output::write_atomically(path, |w| {
         use std::io::Write;
         w.write_all(text.as_bytes()).map_err(|source| englobe_render::OutputError::Io { path: path.to_owned(), source })
     })
-    .with_context(|| format!("cannot write the plot {}", path.display()))
+    .map_err(|source| LabError::Plot { path: path.to_owned(), source })
 }
 
 #[cfg(test)]

@@ -1,0 +1,33 @@
+//! # englobe-lab
+//!
+//! englobe's research, as a library: the seed report's experiment ([`seed_experiment`], on the
+//! scenes and figures of [`seed_report`]) and the comparison of every acceleration structure on one
+//! scene ([`compare`]), both built on [`measure`] (build, render, time, compare images); their
+//! reports ([`report`]: tables and JSON) and plot ([`plot`]: SVG). The `englobe` command parses its
+//! arguments and calls these; a program can call them as well:
+//!
+//! ```no_run
+//! use englobe_lab::{SeedOptions, run_seed};
+//!
+//! let options = SeedOptions { size: Some(64), tests: vec![1], ..SeedOptions::default() };
+//! let experiment = run_seed(&options, &mut |line| eprintln!("{line}"))?;
+//! print!("{}{}", experiment.table(), experiment.claims());
+//! assert!(experiment.images_identical());
+//! # Ok::<(), englobe_lab::LabError>(())
+//! ```
+//!
+//! [`error`] is the bottom module and [`seed_experiment`] and [`compare`] the top ones; no module
+//! imports one above it.
+
+pub mod compare;
+pub mod error;
+pub mod measure;
+pub mod memory;
+pub mod plot;
+pub mod report;
+pub mod seed_experiment;
+pub mod seed_report;
+
+pub use compare::{CompareOptions, CompareRow, Comparison, run_compare};
+pub use error::LabError;
+pub use seed_experiment::{SeedExperiment, SeedOptions, SeedRow, run_seed};
