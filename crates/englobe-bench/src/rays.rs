@@ -9,7 +9,7 @@
 //!   blocks in row order, the 16 pixels of a block in row order), so that 16 consecutive rays
 //!   form a square packet.
 //! * **random**: origins uniform in the bounding box, directions uniform on the unit sphere
-//!   (`z = 1 - 2u`, `phi = 2 pi v`): SplitMix64 started from the seed, three numbers for the
+//!   (`z = 1 - 2u`, `phi = 2 pi v`): PCG32 started from the seed, three numbers for the
 //!   origin, then two for the direction, ray after ray.
 //! * **bounce**: from the primary rays' closest hits (found with englobe, which agrees with brute
 //!   force exactly), cosine-distributed about the hit triangle's geometric normal turned to face
@@ -17,7 +17,7 @@
 //!   hemisphere), leaving from the hit point pushed off the surface along that normal by
 //!   `1e-4 * (r + max |centre coordinate|)`, which is far above the rounding error of the hit
 //!   point's coordinates. Bounce ray `k` leaves the `(k mod hits)`-th hit in primary order, so
-//!   hits are reused evenly when there are fewer hits than rays. The generator is SplitMix64
+//!   hits are reused evenly when there are fewer hits than rays. The generator is PCG32
 //!   started from the bitwise complement of the seed; two numbers per ray.
 //!
 //! Every direction has unit length and every ray covers `0..=inf`, so that the hit distance `t`
@@ -28,7 +28,7 @@ use std::f32::consts::PI;
 use englobe::Vec3;
 
 use crate::library::{BenchRay, RayResult};
-use crate::rng::SplitMix64;
+use crate::rng::BenchRng;
 use crate::scene::BenchScene;
 
 /// The camera's field of view, in degrees.
@@ -147,7 +147,7 @@ pub fn uniform_direction(u: f32, v: f32) -> Vec3 {
 /// The random rays.
 pub fn random_rays(scene: &BenchScene, count: usize, seed: u64) -> Vec<BenchRay> {
     let b = scene.bounds();
-    let mut rng = SplitMix64::new(seed);
+    let mut rng = BenchRng::new(seed);
     (0..count)
         .map(|_| {
             let o = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32());
@@ -209,7 +209,7 @@ pub fn bounce_rays(
         return Vec::new();
     }
     let offset = bounce_offset(scene);
-    let mut rng = SplitMix64::new(!seed);
+    let mut rng = BenchRng::new(!seed);
     (0..count)
         .map(|k| {
             let i = hit_rays[k % hit_rays.len()];
@@ -266,7 +266,7 @@ mod tests {
 
     #[test]
     fn bases_are_orthonormal() {
-        let mut rng = SplitMix64::new(1);
+        let mut rng = BenchRng::new(1);
         for _ in 0..10_000 {
             let n = uniform_direction(rng.next_f32(), rng.next_f32());
             let (t, b) = orthonormal_basis(n);
@@ -280,7 +280,7 @@ mod tests {
     #[test]
     fn cosine_directions_have_the_cosine_mean() {
         // E[cos] = 2/3 for a cosine-weighted hemisphere.
-        let mut rng = SplitMix64::new(3);
+        let mut rng = BenchRng::new(3);
         let n = Vec3::new(0.3, -0.5, 0.8).normalize();
         let count = 200_000;
         let mean: f32 = (0..count)

@@ -17,7 +17,7 @@ use anyhow::Context;
 use englobe::Aabb;
 use englobe::accel::Bvh;
 use englobe::accel::bvh::validate_bvh;
-use englobe::accel::bvh::{BinnedSah, Ploc, SeedPairing, SweepSah};
+use englobe::accel::{BinnedSah, Ploc, SeedPairing, SweepSah};
 use englobe_scene::mesh::load_mesh_file;
 
 /// A builder with its settings, ready to run on boxes.

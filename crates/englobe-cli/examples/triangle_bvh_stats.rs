@@ -14,6 +14,8 @@ use std::time::Instant;
 use anyhow::Context;
 use englobe::{Ray, TriangleBvh, Vec3, WorkCounts};
 use englobe_scene::mesh::load_mesh_file;
+use rand::{Rng, SeedableRng};
+use rand_pcg::Pcg32;
 
 fn main() -> anyhow::Result<()> {
     for path in std::env::args().skip(1) {
@@ -46,13 +48,8 @@ fn main() -> anyhow::Result<()> {
         );
         // Random rays: uniform origins in the box, uniform directions (the harness's random set).
         let (lo, extent) = (mesh.bounds().min, mesh.bounds().extent());
-        let mut state = 0x9e37_79b9_7f4a_7c15u64;
-        let mut next = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 40) as f32 / (1u64 << 24) as f32
-        };
+        let mut rng = Pcg32::seed_from_u64(0x9e37_79b9_7f4a_7c15);
+        let mut next = move || (rng.next_u32() >> 8) as f32 / (1u32 << 24) as f32;
         let mut c = WorkCounts::default();
         let n = 100_000;
         let mut hits = 0;
