@@ -2,7 +2,8 @@
 
 use glam::Vec3;
 
-use super::{Bounded, Intersect, PrimHit};
+use super::{Bounded, Intersect};
+use crate::PrimHit;
 use crate::{Aabb, Ray};
 
 /// A solid axis-aligned box.

@@ -3,8 +3,9 @@
 
 use glam::{Vec2, Vec3};
 
+use super::Triangle;
 use super::triangle::{WatertightRay, intersect_triangle};
-use super::{PrimHit, Triangle};
+use crate::PrimHit;
 use crate::{Aabb, Ray};
 
 /// Why a mesh was refused.

@@ -5,6 +5,7 @@
 mod aabox;
 mod clip;
 mod instance;
+mod interface;
 mod mesh;
 mod plane;
 mod sphere;
@@ -18,25 +19,11 @@ pub use plane::Plane;
 pub use sphere::Sphere;
 pub use triangle::{Triangle, WatertightRay, intersect_triangle, is_degenerate};
 
+pub use interface::{Bounded, Intersect};
+
 use glam::Vec3;
 
 use crate::{Aabb, PrimHit, Ray};
-
-/// Anything with a bounding box. Unbounded shapes (planes) return a box with infinite corners.
-pub trait Bounded {
-    /// The tightest axis-aligned box around the shape.
-    fn bounds(&self) -> Aabb;
-}
-
-/// A shape a ray can be tested against exactly.
-pub trait Intersect: Bounded {
-    /// The nearest hit with `t` in the ray's interval `t_min..=t_max`, if any.
-    fn intersect(&self, ray: &Ray) -> Option<PrimHit>;
-
-    /// The unit geometric normal at the surface point `p` of `hit`. It points outward for closed
-    /// shapes and along the winding's right-hand normal for triangles, whichever side the ray came from.
-    fn normal(&self, p: Vec3, hit: &PrimHit) -> Vec3;
-}
 
 /// One shape of any kind, the unit a [`crate::World`] is made of.
 #[derive(Clone, Debug, PartialEq)]

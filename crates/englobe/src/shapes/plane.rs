@@ -3,7 +3,8 @@
 
 use glam::Vec3;
 
-use super::{Bounded, Intersect, PrimHit};
+use super::{Bounded, Intersect};
+use crate::PrimHit;
 use crate::{Aabb, Ray};
 
 /// The plane of points `p` with `normal · p = offset`; `normal` has unit length.

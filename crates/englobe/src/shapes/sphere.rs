@@ -9,7 +9,8 @@
 
 use glam::{DVec3, Vec3};
 
-use super::{Bounded, Intersect, PrimHit};
+use super::{Bounded, Intersect};
+use crate::PrimHit;
 use crate::{Aabb, Ray};
 
 /// A sphere of centre `center` and radius `radius > 0`.

@@ -13,7 +13,8 @@
 
 use glam::Vec3;
 
-use super::{Bounded, Intersect, PrimHit};
+use super::{Bounded, Intersect};
+use crate::PrimHit;
 use crate::geom::aabb::ROBUST_FAR_SCALE;
 use crate::{Aabb, Ray};
 

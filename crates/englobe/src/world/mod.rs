@@ -24,69 +24,19 @@
 //! Every kind gives the same answers, bit for bit: a triangle's test is the same watertight test
 //! everywhere, and ties at equal `t` go to the lower number at every level.
 
-use std::sync::Arc;
-
 use glam::Vec3;
 
 mod bottom;
+mod object;
 mod query;
 
 use crate::PrimHit;
 use crate::accel::{Accel, AccelKind, AnyAccel, MAX_PRIMITIVES, StructureStats, TriangleBvh};
-use crate::shapes::{Bounded, Instance, Intersect, Shape, TriangleMesh, clip_triangle};
+use crate::shapes::{Bounded, Intersect, Shape, clip_triangle};
 use crate::{Aabb, Ray};
 
 pub use bottom::BottomLevel;
-
-/// One object of a world.
-#[derive(Clone, Debug, PartialEq)]
-pub enum Object {
-    /// A single shape.
-    Shape(Shape),
-    /// A triangle mesh: each triangle is a primitive of its own.
-    Mesh(Arc<TriangleMesh>),
-    /// A mesh placed by a transform: one primitive of the world's structure, traced through a
-    /// bottom-level structure over the mesh that all instances of the same mesh share.
-    Instance(Instance),
-}
-
-impl<S: Into<Shape>> From<S> for Object {
-    fn from(s: S) -> Self {
-        Object::Shape(s.into())
-    }
-}
-
-impl From<TriangleMesh> for Object {
-    fn from(m: TriangleMesh) -> Self {
-        Object::Mesh(Arc::new(m))
-    }
-}
-
-impl From<Instance> for Object {
-    fn from(i: Instance) -> Self {
-        Object::Instance(i)
-    }
-}
-
-impl Object {
-    /// Number of primitives the object contributes to the world's structure.
-    pub fn primitive_count(&self) -> usize {
-        match self {
-            Object::Shape(_) | Object::Instance(_) => 1,
-            Object::Mesh(m) => m.len(),
-        }
-    }
-
-    /// Number of triangles the object puts in the picture (an instance counts its mesh's).
-    pub fn triangle_count(&self) -> usize {
-        match self {
-            Object::Shape(Shape::Triangle(_)) => 1,
-            Object::Shape(_) => 0,
-            Object::Mesh(m) => m.len(),
-            Object::Instance(i) => i.mesh().len(),
-        }
-    }
-}
+pub use object::Object;
 
 /// Why a world could not be built.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -357,6 +307,7 @@ impl World {
 mod tests {
     use super::*;
     use crate::accel::{NoCount, WorkCounts};
+    use crate::shapes::TriangleMesh;
     use crate::shapes::{Plane, Sphere, Triangle};
 
     fn sample() -> Vec<Object> {

@@ -22,6 +22,13 @@ fn beats(hit: &WorldHit, best: Option<&WorldHit>) -> bool {
 }
 
 impl World {
+    /// Whether [`World::accel`] holds anything (on the fast path, whether there are shapes or
+    /// instances beside the meshes): a world of meshes and planes skips its query.
+    #[inline(always)]
+    fn accel_in_use(&self) -> bool {
+        self.accel_prims.as_ref().is_none_or(|p| !p.is_empty())
+    }
+
     /// The world's primitive number of primitive `i` of [`World::accel`].
     #[inline(always)]
     fn accel_prim(&self, i: u32) -> u32 {
@@ -57,22 +64,24 @@ impl World {
         // Only the teaching structures test mesh triangles through their closure.
         let mut watertight = None;
         let bounded = ray.with_range(ray.t_min, best.map_or(ray.t_max, |b| b.t));
-        let found = self.accel.closest_hit(&bounded, counters, |i, r| {
-            let (object, local) = self.locate(self.accel_prim(i));
-            match &self.objects[object as usize] {
-                Object::Shape(s) => s.intersect(r),
-                Object::Mesh(m) => {
-                    m.intersect_with(local, r, watertight.get_or_insert_with(|| WatertightRay::new(ray)))
+        let found = self.accel_in_use().then(|| {
+            self.accel.closest_hit(&bounded, counters, |i, r| {
+                let (object, local) = self.locate(self.accel_prim(i));
+                match &self.objects[object as usize] {
+                    Object::Shape(s) => s.intersect(r),
+                    Object::Mesh(m) => {
+                        m.intersect_with(local, r, watertight.get_or_insert_with(|| WatertightRay::new(ray)))
+                    }
+                    Object::Instance(inst) => {
+                        let hit = self.instance_closest_hit(object, inst, r, &mut nested)?;
+                        instance_hits.offer(i, &hit);
+                        Some(PrimHit { t: hit.t, u: hit.u, v: hit.v })
+                    }
                 }
-                Object::Instance(inst) => {
-                    let hit = self.instance_closest_hit(object, inst, r, &mut nested)?;
-                    instance_hits.offer(i, &hit);
-                    Some(PrimHit { t: hit.t, u: hit.u, v: hit.v })
-                }
-            }
+            })
         });
         counters.merge(&nested);
-        if let Some(h) = found {
+        if let Some(h) = found.flatten() {
             let (object, local) = self.locate(self.accel_prim(h.prim));
             let prim = match &self.objects[object as usize] {
                 Object::Instance(inst) => instance_hits.triangle(h.prim, h.t).unwrap_or_else(|| {
@@ -118,6 +127,9 @@ impl World {
         if unbounded_hit || self.triangles.as_ref().is_some_and(|t| t.any_hit(ray, counters)) {
             return true;
         }
+        if !self.accel_in_use() {
+            return false;
+        }
         let mut nested = C::default();
         let mut watertight = None;
         let hit = self.accel.any_hit(ray, counters, |i, r| {
@@ -132,5 +144,144 @@ impl World {
         });
         counters.merge(&nested);
         hit
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::{Affine3A, Quat, Vec3};
+    use rand::{RngExt, SeedableRng};
+    use rand_pcg::Pcg32;
+
+    use std::sync::Arc;
+
+    use super::*;
+    use crate::AccelKind;
+    use crate::accel::{NoCount, WorkCounts};
+    use crate::shapes::{Instance, Sphere, TriangleMesh};
+
+    fn cube() -> Arc<TriangleMesh> {
+        let p = (0..8).map(|i| Vec3::new((i & 1) as f32, ((i >> 1) & 1) as f32, ((i >> 2) & 1) as f32)).collect();
+        let quads = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
+        let tris = quads.iter().flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]]).collect();
+        Arc::new(TriangleMesh::new(p, tris).unwrap())
+    }
+
+    fn baked(mesh: &TriangleMesh, m: &Affine3A) -> TriangleMesh {
+        TriangleMesh::new(mesh.positions().iter().map(|&p| m.transform_point3(p)).collect(), mesh.triangles().to_vec())
+            .unwrap()
+    }
+
+    fn placements() -> Vec<Affine3A> {
+        (0..5)
+            .map(|i| {
+                Affine3A::from_scale_rotation_translation(
+                    Vec3::new(1.0 + i as f32 * 0.5, 1.0, 2.0),
+                    Quat::from_euler(glam::EulerRot::XYZ, 0.3 * i as f32, 0.7, -0.2 * i as f32),
+                    Vec3::new(i as f32 * 3.0 - 6.0, 0.5 * i as f32, 10.0),
+                )
+            })
+            .collect()
+    }
+
+    #[test]
+    fn instances_share_one_bottom_level_structure() {
+        let mesh = cube();
+        let other = cube();
+        let mut objects: Vec<Object> =
+            placements().iter().map(|m| Instance::new(mesh.clone(), *m).unwrap().into()).collect();
+        objects.push(Instance::new(other, Affine3A::IDENTITY).unwrap().into());
+        let w = World::build(objects, AccelKind::None).unwrap();
+        assert_eq!(w.bottom_levels().len(), 2);
+        assert_eq!(w.primitive_count(), 6);
+        assert_eq!(w.triangle_count(), 72);
+        assert_eq!(Arc::strong_count(&mesh), 6 + 1, "five instances, one structure, and this handle");
+    }
+
+    #[test]
+    fn on_the_fast_path_every_mesh_is_a_triangle_bvh() {
+        let mesh = cube();
+        let objects: Vec<Object> = vec![
+            Object::Mesh(mesh.clone()),
+            Instance::new(mesh.clone(), Affine3A::from_translation(Vec3::X * 3.0)).unwrap().into(),
+            Object::Mesh(cube()),
+            Sphere::new(Vec3::new(0.0, 5.0, 0.0), 1.0).into(),
+        ];
+        let w = World::build(objects, AccelKind::BvhWide).unwrap();
+        assert_eq!(w.bottom_levels().len(), 1);
+        assert!(w.bottom_levels()[0].triangle_bvh().is_some());
+        // The plain meshes' triangles in one structure, the instance and the sphere in the other.
+        assert_eq!(w.triangles().unwrap().stats().prim_refs, 24);
+        assert_eq!(w.accel().stats().prim_refs, 2);
+        assert_eq!(w.primitive_count(), 12 + 1 + 12 + 1);
+        assert_eq!(w.stats().prim_refs, 12 + 1 + 12 + 1);
+        let hit = w.closest_hit(&Ray::new(Vec3::new(3.25, 0.75, -1.0), Vec3::Z), &mut NoCount).unwrap();
+        assert_eq!((hit.object, hit.prim, hit.t), (1, 0, 1.0));
+        let hit = w.closest_hit(&Ray::new(Vec3::new(0.25, 0.75, -1.0), Vec3::Z), &mut NoCount).unwrap();
+        assert_eq!((hit.object, hit.prim, hit.t), (0, 0, 1.0), "the first of two identical meshes");
+        let hit = w.closest_hit(&Ray::new(Vec3::new(0.0, 9.0, 0.0), -Vec3::Y), &mut NoCount).unwrap();
+        assert_eq!((hit.object, hit.prim, hit.t), (3, 0, 3.0));
+    }
+
+    #[test]
+    fn instances_answer_like_the_same_meshes_baked_into_the_world() {
+        let mesh = cube();
+        let mut instanced: Vec<Object> = vec![Sphere::new(Vec3::new(0.0, 0.0, 14.0), 1.5).into()];
+        let mut flat = instanced.clone();
+        for m in placements() {
+            instanced.push(Instance::new(mesh.clone(), m).unwrap().into());
+            flat.push(baked(&mesh, &m).into());
+        }
+        let wi = World::build(instanced, AccelKind::None).unwrap();
+        let wf = World::build(flat, AccelKind::None).unwrap();
+        let mut rng = Pcg32::seed_from_u64(0x2545_f491);
+        let mut next = move || rng.random::<f32>();
+        let (mut hits, mut counts) = (0, WorkCounts::default());
+        for _ in 0..4000 {
+            let target = Vec3::new(next() * 16.0 - 8.0, next() * 6.0 - 2.0, 8.0 + next() * 8.0);
+            let ray = Ray::new(Vec3::new(0.0, 1.0, -5.0), target - Vec3::new(0.0, 1.0, -5.0));
+            let a = wi.closest_hit(&ray, &mut counts);
+            let b = wf.closest_hit(&ray, &mut NoCount);
+            assert_eq!(a.is_some(), b.is_some(), "{ray:?}");
+            assert_eq!(wi.any_hit(&ray, &mut NoCount), wf.any_hit(&ray, &mut NoCount));
+            let (Some(a), Some(b)) = (a, b) else { continue };
+            hits += 1;
+            let p = wi.hit_point(&ray, &a);
+            assert!((a.t - b.t).abs() <= 1e-4 * b.t, "{a:?} vs {b:?}");
+            assert_eq!((a.object, a.prim), (b.object, b.prim));
+            let (na, nb) = (wi.geometric_normal(&a, p), wf.geometric_normal(&b, p));
+            assert!((na - nb).length() < 1e-4, "{na} vs {nb}");
+            assert!((wi.shading_normal(&a, p) - wf.shading_normal(&b, p)).length() < 1e-4);
+        }
+        assert!(hits > 1000, "only {hits} hits: the test scene is off camera");
+        // Brute force over 6 world primitives, plus a mesh box and the mesh's 12 triangles for
+        // every instance whose box the ray enters.
+        assert!(counts.exact_tests >= 4000 * 6 && counts.box_tests >= 4000 * 5, "{counts:?}");
+        assert_eq!((counts.exact_tests - 4000 * 6) % 12, 0, "{counts:?}");
+    }
+
+    #[test]
+    fn the_closest_of_overlapping_instances_wins_with_its_own_triangle() {
+        let mesh = cube();
+        let near = Affine3A::from_translation(Vec3::new(0.0, 0.0, 5.0));
+        let far = Affine3A::from_translation(Vec3::new(0.0, 0.0, 5.5));
+        for kind in [AccelKind::None, AccelKind::BvhWide, AccelKind::KdTree] {
+            // The far one first: the near one has the higher index but the smaller t.
+            let w = World::build(
+                vec![
+                    Instance::new(mesh.clone(), far).unwrap().into(),
+                    Instance::new(mesh.clone(), near).unwrap().into(),
+                ],
+                kind,
+            )
+            .unwrap();
+            let ray = Ray::new(Vec3::new(0.25, 0.75, 0.0), Vec3::Z);
+            let hit: WorldHit = w.closest_hit(&ray, &mut NoCount).unwrap();
+            assert_eq!((hit.object, hit.t), (1, 5.0), "{kind}");
+            // The face z = 0 is triangles 0 and 1; (0.25, 0.75) lies in the second.
+            assert_eq!(hit.prim, 0, "{kind}");
+            assert_eq!(w.geometric_normal(&hit, ray.at(hit.t)), -Vec3::Z);
+            assert!(!w.any_hit(&Ray::segment(Vec3::new(0.25, 0.75, 0.0), Vec3::Z, 0.0, 4.9), &mut NoCount));
+        }
     }
 }

@@ -98,16 +98,6 @@ mod tests {
     }
 
     #[test]
-    fn leaf_sizes_are_counted_and_large_ones_pooled() {
-        let boxes: Vec<Aabb> = (0..30).map(|_| Aabb::new(Vec3::ZERO, Vec3::ONE)).collect();
-        // Identical boxes: leaves of 8, split by count: 30 = 7 + 8 + 7 + 8.
-        let bvh = crate::accel::bvh::BinnedSah::default().build(&boxes);
-        assert_eq!(bvh.leaf_sizes(), [0, 0, 0, 0, 0, 0, 2, 2, 0]);
-        let one = crate::accel::bvh::BinnedSah { bins: 8, max_leaf: 30, small_leaf: 0 }.build(&boxes);
-        assert_eq!(one.leaf_sizes(), [0, 0, 0, 0, 0, 0, 0, 0, 1]);
-    }
-
-    #[test]
     fn flat_roots_count_every_node() {
         let flat = Aabb::new(Vec3::ZERO, Vec3::new(1.0, 0.0, 0.0));
         let bvh = SeedPairing::build(&[flat, flat, flat]);

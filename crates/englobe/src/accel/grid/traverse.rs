@@ -10,7 +10,7 @@
 //!   the closest hit is at or beyond the cell's exit: a primitive in the next cell hit at exactly
 //!   that distance may win the tie by its lower index.
 //! * **Mailboxing.** A primitive listed in several cells along the ray is tested once (see
-//!   [`crate::accel::mailbox`]).
+//!   [`crate::accel::interface::mailbox`]).
 //! * **Robustness.** The distances to the next faces are computed afresh from each face's position
 //!   (not accumulated, which would drift), and the start cell is found from the entry point moved
 //!   back along the ray by its rounding error, so the walk never starts past the cell the ray

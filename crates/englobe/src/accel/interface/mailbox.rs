@@ -17,7 +17,7 @@
 
 use std::ops::ControlFlow;
 
-use super::HitRecord;
+use super::contract::HitRecord;
 use super::counters::Counters;
 use crate::PrimHit;
 use crate::Ray;

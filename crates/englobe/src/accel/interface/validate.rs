@@ -3,8 +3,8 @@
 //! invariant. Each structure keeps its own detailed checker and error type (for instance
 //! [`crate::accel::bvh::validate_bvh`]); this is the face they all show the test harness.
 
-use super::StructureStats;
 use super::clip::ClipFn;
+use super::contract::StructureStats;
 use crate::Aabb;
 
 /// A structure that can check itself.

@@ -24,7 +24,7 @@
 //!   plane there) before the side it goes to.
 //!
 //! A primitive referenced by several leaves along the ray is tested once (see
-//! [`crate::accel::mailbox`]).
+//! [`crate::accel::interface::mailbox`]).
 
 use std::ops::ControlFlow;
 

@@ -101,7 +101,7 @@ mod tests {
     use crate::shapes::{Bounded, Intersect, Sphere};
 
     #[test]
-    fn counts_the_boxes_entered_before_the_hit_and_no_bvh_does_fewer() {
+    fn counts_the_boxes_entered_before_the_hit() {
         // Five spheres along +z, the third one's box reaching in front of the second's sphere.
         let spheres: Vec<Sphere> = [2.0, 5.0, 6.5, 20.0, 30.0]
             .iter()
@@ -125,17 +125,5 @@ mod tests {
         let miss = Ray::new(Vec3::new(5.0, 0.0, -1.0), -Vec3::Z);
         assert!(bound.closest_hit(&miss, &mut c, |i, r| spheres[i as usize].intersect(r)).is_none());
         assert_eq!(c.exact_tests, 0);
-        // A grazing ray entering several boxes: every BVH makes at least as many tests.
-        let graze = Ray::new(Vec3::new(0.9, 0.9, -10.0), Vec3::new(0.0, 0.0, 1.0));
-        let mut b = WorkCounts::default();
-        let expected = bound.closest_hit(&graze, &mut b, |i, r| spheres[i as usize].intersect(r));
-        assert!(b.exact_tests >= 3, "{b:?}");
-        for kind in crate::AccelKind::ALL.iter().copied().filter(|&k| k != crate::AccelKind::None) {
-            let accel = crate::AnyAccel::build(kind, &boxes);
-            let mut w = WorkCounts::default();
-            let got = accel.closest_hit(&graze, &mut w, |i, r| spheres[i as usize].intersect(r));
-            assert_eq!(got, expected, "{kind}");
-            assert!(w.exact_tests >= b.exact_tests, "{kind}: {w:?} below the bound {b:?}");
-        }
     }
 }

@@ -213,8 +213,9 @@ mod tests {
 
     use super::traverse::INLINE_DEPTH;
     use super::*;
+    use crate::accel::NoCount;
     use crate::accel::bvh::{BuildKind, BuildNode, BuildTree};
-    use crate::accel::{AccelKind, AnyAccel, NoCount};
+    use crate::accel::reference::BruteForce;
     use crate::shapes::AaBox;
 
     /// A chain: interior node `k` holds leaf `k` and node `k + 1`, so the wide tree is about
@@ -244,7 +245,7 @@ mod tests {
         assert!(wide.depth() as usize > INLINE_DEPTH, "depth {}", wide.depth());
         let shapes: Vec<AaBox> = boxes.iter().map(|b| AaBox::new(b.min, b.max)).collect();
         let test = |i: u32, r: &Ray| crate::shapes::Intersect::intersect(&shapes[i as usize], r);
-        let brute = AnyAccel::build(AccelKind::None, &boxes);
+        let brute = BruteForce::build(&boxes);
         let rays: Vec<Ray> = (0..50)
             .flat_map(|k| {
                 let y = 0.1 + k as f32 * 0.015;

@@ -231,4 +231,14 @@ mod tests {
         assert_eq!(bin_of(f32::INFINITY, 0.0, 1.0, 8), 7);
         assert_eq!(bin_of(-1.0, 0.0, 1.0, 8), 0);
     }
+
+    #[test]
+    fn leaf_sizes_are_counted_and_large_ones_pooled() {
+        let boxes: Vec<Aabb> = (0..30).map(|_| Aabb::new(glam::Vec3::ZERO, glam::Vec3::ONE)).collect();
+        // Identical boxes: leaves of 8, split by count: 30 = 7 + 8 + 7 + 8.
+        let bvh = BinnedSah::default().build(&boxes);
+        assert_eq!(bvh.leaf_sizes(), [0, 0, 0, 0, 0, 0, 2, 2, 0]);
+        let one = BinnedSah { bins: 8, max_leaf: 30, small_leaf: 0 }.build(&boxes);
+        assert_eq!(one.leaf_sizes(), [0, 0, 0, 0, 0, 0, 0, 0, 1]);
+    }
 }

@@ -240,4 +240,23 @@ mod tests {
             .collect();
         assert_eq!(Ploc::default().build(&boxes), Ploc::default().build(&boxes));
     }
+
+    #[test]
+    fn treelet_restructuring_never_worsens_the_clustered_tree() {
+        use rand::{RngExt, SeedableRng};
+        use rand_pcg::Pcg32;
+        let mut rng = Pcg32::seed_from_u64(0x2545_f491);
+        let mut next = move || rng.random::<f32>();
+        let boxes: Vec<Aabb> = (0..3000)
+            .map(|_| {
+                let (c, r) = (glam::Vec3::new(next(), next(), next()) * 50.0, 0.2 + next() * 2.0);
+                Aabb::new(c - glam::Vec3::splat(r), c + glam::Vec3::splat(r))
+            })
+            .collect();
+        let mut tree = Ploc::default().cluster(&boxes);
+        let before = tree.clone().into_bvh().sah_cost();
+        super::super::treelet::restructure(&mut tree, 1, 2);
+        let after = crate::accel::bvh::validate_bvh(&tree.into_bvh(), &boxes).unwrap().sah_cost;
+        assert!(after <= before, "{before} -> {after}");
+    }
 }

@@ -225,9 +225,9 @@ mod tests {
     use rand_pcg::Pcg32;
 
     use super::*;
+    use crate::accel::SeedPairing;
     use crate::accel::bvh::layout::BuildNode;
     use crate::accel::bvh::validate::validate_bvh;
-    use crate::accel::{Ploc, SeedPairing};
 
     fn cube(c: Vec3, r: f32) -> Aabb {
         Aabb::new(c - Vec3::splat(r), c + Vec3::splat(r))
@@ -288,14 +288,7 @@ mod tests {
     }
 
     #[test]
-    fn it_improves_an_agglomerative_tree_and_a_deep_chain_is_fine() {
-        let boxes = cloud(3000);
-        let mut tree = Ploc::default().cluster(&boxes);
-        let before = tree.clone().into_bvh().sah_cost();
-        restructure(&mut tree, 1, 2);
-        let after = validate_bvh(&tree.into_bvh(), &boxes).unwrap().sah_cost;
-        assert!(after <= before, "{before} -> {after}");
-
+    fn a_deep_chain_is_fine() {
         // A chain 30 000 deep, each level adding one box: walks without recursion.
         let n = 30_000u32;
         let boxes: Vec<Aabb> = (0..n).map(|i| cube(Vec3::new(i as f32, 0.0, 0.0), 0.4)).collect();
