@@ -172,3 +172,37 @@ fn compare_reports_the_quality_of_every_bvh_on_the_dragon() {
     assert_eq!(seed["leaves"].as_u64(), Some(22_866));
     assert!(seed["sah_vs_sweep"].as_f64().unwrap() > 10.0, "{seed}");
 }
+
+/// With no `--accel`, a render goes through the fast path, on a mesh scene and on an instanced
+/// one, and says so in its statistics; the same image as brute force's on the Sponza.
+#[test]
+fn renders_default_to_the_fast_path() {
+    let dir = tempfile::tempdir().unwrap();
+    for scene in ["sponza", "bunny-field"] {
+        let file = example_scene(scene, dir.path());
+        let json = dir.path().join(format!("{scene}.json"));
+        let png = dir.path().join(format!("{scene}.png"));
+        let out = englobe(&[
+            "render",
+            "-q",
+            "--width",
+            "32",
+            "--height",
+            "18",
+            "--stats-json",
+            json.to_str().unwrap(),
+            "-o",
+            png.to_str().unwrap(),
+            file.to_str().unwrap(),
+        ]);
+        assert!(out.status.success(), "{scene}: {}", text(&out.stderr));
+        let stats: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+        assert_eq!(stats["accel"], "bvh-wide", "{scene}");
+    }
+    let brute = dir.path().join("brute.png");
+    let file = dir.path().join("sponza.toml");
+    let args = ["render", "-q", "--width", "32", "--height", "18", "--accel", "none", "-o"];
+    let out = englobe(&[&args[..], &[brute.to_str().unwrap(), file.to_str().unwrap()]].concat());
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert_eq!(std::fs::read(&brute).unwrap(), std::fs::read(dir.path().join("sponza.png")).unwrap());
+}
