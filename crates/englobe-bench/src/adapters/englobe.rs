@@ -93,7 +93,7 @@ pub struct EnglobeLibrary {
 
 /// The structure itself.
 enum Built {
-    World(World),
+    World(Box<World>),
     Triangles(TriangleBvh),
 }
 
@@ -103,7 +103,7 @@ impl EnglobeLibrary {
         match structure {
             EnglobeStructure::World(kind) => {
                 let world = World::build(vec![Object::Mesh(scene.mesh.clone())], kind)?;
-                Ok(EnglobeLibrary { structure, built: Built::World(world) })
+                Ok(EnglobeLibrary { structure, built: Built::World(Box::new(world)) })
             }
             EnglobeStructure::Triangles(isa) => {
                 let mut bvh = TriangleBvh::build(&scene.mesh);

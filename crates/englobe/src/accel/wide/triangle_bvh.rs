@@ -164,7 +164,7 @@ impl TriangleBvh {
         if !ray.is_valid() || self.nodes.is_empty() {
             return None;
         }
-        let mut leaves = TriangleLeaves { blocks: &self.blocks, ray: TriRay::new(ray), best: None, t_max: ray.t_max };
+        let mut leaves = TriangleLeaves { blocks: &self.blocks, source: ray, ray: None, best: None, t_max: ray.t_max };
         dispatch::closest(self.isa, &self.nodes, self.depth, &NodeRay::new(ray), &mut leaves, counters);
         leaves.best
     }
@@ -175,7 +175,7 @@ impl TriangleBvh {
         if !ray.is_valid() || self.nodes.is_empty() {
             return false;
         }
-        let mut leaves = TriangleLeaves { blocks: &self.blocks, ray: TriRay::new(ray), best: None, t_max: ray.t_max };
+        let mut leaves = TriangleLeaves { blocks: &self.blocks, source: ray, ray: None, best: None, t_max: ray.t_max };
         dispatch::any(self.isa, &self.nodes, self.depth, &NodeRay::new(ray), reach(ray.t_max), &mut leaves, counters)
     }
 
@@ -213,35 +213,38 @@ impl TriangleBvh {
 /// A query's view of the triangle blocks, and its closest hit so far.
 struct TriangleLeaves<'a> {
     blocks: &'a [TriBlock],
-    ray: TriRay,
+    source: &'a Ray,
+    /// The triangle test's constants, prepared at the first leaf: a ray that reaches none (one
+    /// that misses the mesh's box, say) never pays for them.
+    ray: Option<TriRay>,
     best: Option<Hit>,
     t_max: f32,
 }
 
-impl TriangleLeaves<'_> {
-    /// Keeps the hit on triangle `prim` if it is closer, or as close with a lower index (the rule
-    /// of [`crate::accel::HitRecord::offer`]).
-    #[inline(always)]
-    fn offer(&mut self, prim: u32, t: f32, u: f32, v: f32) {
-        let better = match self.best {
-            None => true,
-            Some(b) => t < b.t || (t == b.t && prim < b.prim),
-        };
-        if better {
-            self.best = Some(Hit { t, prim, u, v });
-            self.t_max = t;
-        }
+/// Keeps the hit on triangle `prim` in `best` if it is closer, or as close with a lower index
+/// (the rule of [`crate::accel::HitRecord::offer`]), and shrinks `t_max` to it.
+#[inline(always)]
+fn offer(best: &mut Option<Hit>, t_max: &mut f32, prim: u32, t: f32, u: f32, v: f32) {
+    let better = match *best {
+        None => true,
+        Some(b) => t < b.t || (t == b.t && prim < b.prim),
+    };
+    if better {
+        *best = Some(Hit { t, prim, u, v });
+        *t_max = t;
     }
 }
 
 impl<C: Counters> Leaves<C> for TriangleLeaves<'_> {
     #[inline(always)]
     fn closest(&mut self, first: u32, count: u32, counters: &mut C) {
+        let source = self.source;
+        let ray = self.ray.get_or_insert_with(|| TriRay::new(source));
         for block in &self.blocks[first as usize..(first + count) as usize] {
             for _ in 0..block.used() {
                 counters.exact_test();
             }
-            let hits = intersect_block(block, &self.ray, self.t_max);
+            let hits = intersect_block(block, ray, self.t_max);
             if hits.hit | hits.special == 0 {
                 continue;
             }
@@ -250,7 +253,7 @@ impl<C: Counters> Leaves<C> for TriangleLeaves<'_> {
                 let lane = mask.trailing_zeros() as usize;
                 mask &= mask - 1;
                 if block.ids[lane] != UNUSED {
-                    self.offer(block.ids[lane], hits.t[lane], hits.u[lane], hits.v[lane]);
+                    offer(&mut self.best, &mut self.t_max, block.ids[lane], hits.t[lane], hits.u[lane], hits.v[lane]);
                 }
             }
             let mut mask = hits.special;
@@ -258,9 +261,9 @@ impl<C: Counters> Leaves<C> for TriangleLeaves<'_> {
                 let lane = mask.trailing_zeros() as usize;
                 mask &= mask - 1;
                 if block.ids[lane] != UNUSED
-                    && let Some(h) = self.ray.scalar(block, lane, self.t_max)
+                    && let Some(h) = ray.scalar(block, lane, self.t_max)
                 {
-                    self.offer(block.ids[lane], h.t, h.u, h.v);
+                    offer(&mut self.best, &mut self.t_max, block.ids[lane], h.t, h.u, h.v);
                 }
             }
         }
@@ -290,11 +293,13 @@ impl<C: Counters> Leaves<C> for TriangleLeaves<'_> {
 
     #[inline(always)]
     fn any(&mut self, first: u32, count: u32, counters: &mut C) -> bool {
+        let source = self.source;
+        let ray = self.ray.get_or_insert_with(|| TriRay::new(source));
         for block in &self.blocks[first as usize..(first + count) as usize] {
             for _ in 0..block.used() {
                 counters.exact_test();
             }
-            let hits = intersect_block(block, &self.ray, self.t_max);
+            let hits = intersect_block(block, ray, self.t_max);
             // An unused lane repeats a used one: its hit is that lane's.
             if hits.hit != 0 {
                 return true;
@@ -303,7 +308,7 @@ impl<C: Counters> Leaves<C> for TriangleLeaves<'_> {
             while mask != 0 {
                 let lane = mask.trailing_zeros() as usize;
                 mask &= mask - 1;
-                if self.ray.scalar(block, lane, self.t_max).is_some() {
+                if ray.scalar(block, lane, self.t_max).is_some() {
                     return true;
                 }
             }
