@@ -271,16 +271,10 @@ mod tests {
     #[test]
     fn no_structure_makes_fewer_exact_tests_than_the_lower_bound() {
         use crate::accel::WorkCounts;
-        use crate::shapes::{Bounded, Intersect, Sphere};
+        use crate::shapes::Intersect;
         use glam::Vec3;
-        // Five spheres along +z, the third one's box reaching in front of the second's sphere,
-        // and a grazing ray entering several boxes.
-        let spheres: Vec<Sphere> = [2.0, 5.0, 6.5, 20.0, 30.0]
-            .iter()
-            .enumerate()
-            .map(|(i, &z)| Sphere::new(Vec3::new(if i == 0 { 5.0 } else { 0.0 }, 0.0, z), 1.0))
-            .collect();
-        let boxes: Vec<Aabb> = spheres.iter().map(Bounded::bounds).collect();
+        // A grazing ray entering several boxes.
+        let (spheres, boxes) = crate::accel::reference::bound::spheres_along_z();
         let graze = Ray::new(Vec3::new(0.9, 0.9, -10.0), Vec3::new(0.0, 0.0, 1.0));
         let mut b = WorkCounts::default();
         let expected = LowerBound::build(&boxes).closest_hit(&graze, &mut b, |i, r| spheres[i as usize].intersect(r));

@@ -92,23 +92,31 @@ impl Validate for LowerBound {
     }
 }
 
+/// Five spheres along +z, the third one's box reaching in front of the second's sphere, and their
+/// boxes: the scene of the bound's tests and of the registry's test that no structure beats it.
+#[cfg(test)]
+pub(crate) fn spheres_along_z() -> (Vec<crate::Sphere>, Vec<Aabb>) {
+    use crate::shapes::Bounded;
+    let spheres: Vec<crate::Sphere> = [2.0, 5.0, 6.5, 20.0, 30.0]
+        .iter()
+        .enumerate()
+        .map(|(i, &z)| crate::Sphere::new(glam::Vec3::new(if i == 0 { 5.0 } else { 0.0 }, 0.0, z), 1.0))
+        .collect();
+    let boxes = spheres.iter().map(Bounded::bounds).collect();
+    (spheres, boxes)
+}
+
 #[cfg(test)]
 mod tests {
     use glam::Vec3;
 
     use super::*;
     use crate::accel::WorkCounts;
-    use crate::shapes::{Bounded, Intersect, Sphere};
+    use crate::shapes::Intersect;
 
     #[test]
     fn counts_the_boxes_entered_before_the_hit() {
-        // Five spheres along +z, the third one's box reaching in front of the second's sphere.
-        let spheres: Vec<Sphere> = [2.0, 5.0, 6.5, 20.0, 30.0]
-            .iter()
-            .enumerate()
-            .map(|(i, &z)| Sphere::new(Vec3::new(if i == 0 { 5.0 } else { 0.0 }, 0.0, z), 1.0))
-            .collect();
-        let boxes: Vec<Aabb> = spheres.iter().map(Bounded::bounds).collect();
+        let (spheres, boxes) = spheres_along_z();
         let bound = LowerBound::build(&boxes);
         let mut c = WorkCounts::default();
         let hit =
