@@ -11,8 +11,9 @@
 
 use std::sync::Arc;
 
+use englobe::accel::Validate;
 use englobe::{
-    AaBox, AccelKind, Affine3A, Instance, NoCount, Object, Plane, Ray, Sphere, Triangle, TriangleMesh, Vec3,
+    AaBox, Aabb, AccelKind, Affine3A, Instance, NoCount, Object, Plane, Ray, Sphere, Triangle, TriangleMesh, Vec3,
     WorkCounts, World, WorldHit,
 };
 use glam::{EulerRot, Quat};
@@ -175,6 +176,20 @@ fn make_ray(objects: &[Object], spec: &RaySpec) -> Ray {
     }
 }
 
+/// The box of every primitive by its world number (objects in order, a plain mesh's triangles one
+/// by one), empty for those that are not mesh triangles: what the fast path's triangle structure
+/// is checked against.
+fn triangle_boxes(objects: &[Object]) -> Vec<Aabb> {
+    objects
+        .iter()
+        .flat_map(|o| match o {
+            Object::Mesh(m) => (0..m.len() as u32).map(|t| m.triangle_bounds(t)).collect(),
+            Object::Shape(s) if !s.is_bounded() => vec![],
+            _ => vec![Aabb::EMPTY],
+        })
+        .collect()
+}
+
 /// Every kind against brute force: the same hit bit for bit, the same any-hit answer, whether
 /// work is counted or not.
 fn check(objects: Vec<Object>, rays: &[Ray]) -> Result<(), TestCaseError> {
@@ -184,6 +199,10 @@ fn check(objects: Vec<Object>, rays: &[Ray]) -> Result<(), TestCaseError> {
     for &kind in AccelKind::ALL {
         let world = World::build(objects.clone(), kind).expect("finite objects");
         prop_assert_eq!(world.primitive_count(), brute.primitive_count());
+        if let Some(triangles) = world.triangles() {
+            let stats = triangles.validate(&triangle_boxes(&objects), None);
+            prop_assert!(stats.is_ok(), "{}: {:?}", kind, stats.err());
+        }
         for (ray, (closest, any)) in rays.iter().zip(&expected) {
             let got = world.closest_hit(ray, &mut NoCount);
             prop_assert_eq!(got, *closest, "{}: closest hit of {:?}", kind, ray);

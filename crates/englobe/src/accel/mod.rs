@@ -13,7 +13,7 @@
 //!   and, in [`bvh::build`], its builders), [`wide`] (the eight-wide SIMD BVH and the triangle
 //!   BVH: the fast path), [`kdtree`] (the SAH kd-tree) and [`grid`] (the uniform grid with its
 //!   3D-DDA).
-//! * [`reference`]: the seed report's own BVH and traversal, brute force (the oracle) and the
+//! * [`reference`](mod@reference): the seed report's own BVH and traversal, brute force (the oracle) and the
 //!   lower bound (a yardstick), apart from the field's structures.
 //! * [`select`]: the registry, [`AccelKind`] to a built structure; it imports every structure.
 

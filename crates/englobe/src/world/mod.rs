@@ -14,7 +14,8 @@
 //!   scene: the triangles of every plain mesh in one [`TriangleBvh`] (triangles in SIMD blocks in
 //!   its leaves, numbered as above, so one query covers them all with no overlap between
 //!   meshes); the shapes and instances in a [`crate::WideBvh`] whose leaves call the exact test;
-//!   every instanced mesh a [`TriangleBvh`] of its own.
+//!   every instanced mesh a [`TriangleBvh`] of its own. A world without a plain mesh has the wide
+//!   BVH alone, over every primitive.
 //! * The teaching structures are measured as the seed report measured its own: one structure of
 //!   the kind over every primitive (each triangle of a plain mesh among them), and instanced
 //!   meshes below in a structure of the same kind. Structures that split primitives across cells
@@ -86,7 +87,8 @@ pub struct World {
     /// The primitive number of each of `accel`'s primitives, where they are not all of them in
     /// order (the fast path, whose `accel` holds only shapes and instances).
     accel_prims: Option<Vec<u32>>,
-    /// The fast path: every triangle of every plain mesh, by primitive number.
+    /// The fast path, if the world has a plain mesh: every triangle of every plain mesh, by
+    /// primitive number.
     triangles: Option<TriangleBvh>,
     /// Bottom-level structures, one per distinct instanced mesh, shared by its instances.
     bottom: Vec<BottomLevel>,
@@ -152,22 +154,27 @@ impl World {
         }
         let (accel, accel_prims, triangles) = if kind == AccelKind::BvhWide {
             let in_mesh = |prim: u32| matches!(objects[prim_object[prim as usize] as usize], Object::Mesh(_));
-            // Primitives that are not mesh triangles get no triangle: the builder leaves out
-            // triangles with non-finite corners.
-            let triangles = TriangleBvh::build_with(
-                total,
-                |prim| {
-                    let object = prim_object[prim as usize];
-                    match &objects[object as usize] {
-                        Object::Mesh(m) => m.triangle(prim - object_first_prim[object as usize]).vertices,
-                        _ => [Vec3::NAN; 3],
-                    }
-                },
-                Default::default(),
-            );
             let others: Vec<u32> = (0..total as u32).filter(|&p| !in_mesh(p)).collect();
-            let other_boxes: Vec<Aabb> = others.iter().map(|&p| boxes[p as usize]).collect();
-            (AnyAccel::build(kind, &other_boxes), Some(others), Some(triangles))
+            if others.len() == total {
+                // No mesh: one wide BVH over every primitive, in their own order.
+                (AnyAccel::build(kind, &boxes), None, None)
+            } else {
+                // Primitives that are not mesh triangles get no triangle: the builder leaves out
+                // triangles with non-finite corners.
+                let triangles = TriangleBvh::build_with(
+                    total,
+                    |prim| {
+                        let object = prim_object[prim as usize];
+                        match &objects[object as usize] {
+                            Object::Mesh(m) => m.triangle(prim - object_first_prim[object as usize]).vertices,
+                            _ => [Vec3::NAN; 3],
+                        }
+                    },
+                    Default::default(),
+                );
+                let other_boxes: Vec<Aabb> = others.iter().map(|&p| boxes[p as usize]).collect();
+                (AnyAccel::build(kind, &other_boxes), Some(others), Some(triangles))
+            }
         } else {
             // Split clipping: a triangle's exact part in a cell, any other shape's box's part.
             let clip = |prim: u32, cell: &Aabb| {
@@ -215,7 +222,8 @@ impl World {
     }
 
     /// The fast path's structure over every triangle of every plain mesh (`None` for the
-    /// teaching structures). Its triangle numbers are the world's primitive numbers.
+    /// teaching structures and for a world without a plain mesh). Its triangle numbers are the
+    /// world's primitive numbers.
     pub fn triangles(&self) -> Option<&TriangleBvh> {
         self.triangles.as_ref()
     }

@@ -13,7 +13,7 @@
 //! one list tested at the end (and the tie rule of [`HitRecord`] makes the answer independent of
 //! the order). Occlusion queries test candidates in the same order and stop at the first occluder.
 //!
-//! The recursion is as deep as the tree, and [`crate::accel::bvh::SeedPairing`] builds balanced
+//! The recursion is as deep as the tree, and [`super::SeedPairing`] builds balanced
 //! trees (`ceil(log2(n))` levels), so it stays within a few dozen frames.
 
 use std::ops::ControlFlow;

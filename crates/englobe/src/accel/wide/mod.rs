@@ -14,7 +14,7 @@
 //! Files:
 //!
 //! * [`node`]: the 256-byte node, child references, the scalar reference slab test.
-//! * [`convert`]: binary tree to wide nodes (largest boxes pulled up first).
+//! * [`convert`](mod@convert): binary tree to wide nodes (largest boxes pulled up first).
 //! * [`isa`]: the instruction sets, detected at run time; [`kernels`]: the slab test of eight
 //!   children for each; [`dispatch`]: the per-query choice.
 //! * [`traverse`]: the single-ray traversal, generic over kernels and leaves.

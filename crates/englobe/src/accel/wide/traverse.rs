@@ -11,7 +11,7 @@
 //!
 //! The traversal is generic over the node test ([`NodeKernel`], one per instruction set) and over
 //! what leaves hold ([`Leaves`]: primitive references tested by a closure, or blocks of
-//! triangles). [`dispatch`] calls the instance compiled for the structure's instruction set.
+//! triangles). [`dispatch`](super::dispatch) calls the instance compiled for the structure's instruction set.
 //!
 //! The stack holds at most seven entries per level of the path from the root, so the tree's
 //! recorded depth bounds it: trees up to [`INLINE_DEPTH`] levels deep use an uninitialised array on

@@ -4,7 +4,7 @@
 //! u, v)`, exactly as the scalar watertight test and brute force would answer them.
 //!
 //! Built by the binned SAH builder ([`BinnedSah`], parallel), converted to eight-wide nodes
-//! ([`super::convert`]) with subtrees of up to four triangles collapsed into one block.
+//! ([`super::convert`](mod@super::convert)) with subtrees of up to four triangles collapsed into one block.
 
 use glam::Vec3;
 

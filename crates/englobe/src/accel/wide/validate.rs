@@ -90,7 +90,7 @@ impl Validate for WideBvh {
 impl Validate for TriangleBvh {
     /// `prim_boxes[i]` is the box of triangle `i`.
     fn validate(&self, prim_boxes: &[Aabb], _clip: Option<ClipFn<'_>>) -> Result<StructureStats, InvalidStructure> {
-        let blocks = self.blocks();
+        let (blocks, stats) = (self.blocks(), self.stats());
         let checked = walk(self.nodes(), self.bounds(), self.depth(), prim_boxes.len(), |b, first, count, seen| {
             for block in blocks.get(first..first + count).ok_or("bad leaf range")? {
                 if block.used() == 0 {
@@ -114,12 +114,12 @@ impl Validate for TriangleBvh {
                 return Err(format!("triangle {p} is in {} leaves", seen[p]));
             }
             let stored = seen.iter().filter(|&&s| s == 1).count();
-            match stored == self.stats().prim_refs {
+            match stored == stats.prim_refs {
                 true => Ok(()),
-                false => Err(format!("{stored} triangles in the leaves, {} recorded", self.stats().prim_refs)),
+                false => Err(format!("{stored} triangles in the leaves, {} recorded", stats.prim_refs)),
             }
         });
         checked.map_err(|e| InvalidStructure::new("triangle BVH", WideBvhError(e)))?;
-        Ok(self.stats())
+        Ok(stats)
     }
 }
