@@ -17,6 +17,7 @@
 
 pub mod camera;
 pub mod cost;
+pub mod digest;
 pub mod emitters;
 pub mod film;
 pub mod heatmap;
@@ -27,6 +28,7 @@ pub mod render;
 pub mod sampling;
 pub mod shading;
 pub mod stats;
+pub mod tile;
 pub mod whitted;
 
 pub use camera::PinholeCamera;
@@ -37,6 +39,7 @@ pub use output::{OutputError, OutputFormat, write_image};
 pub use path::PathTracer;
 pub use render::{RenderError, RenderOutput, Renderer};
 pub use stats::{KindStats, RayKind, RenderStats};
+pub use tile::{PixelWindow, TileSpec};
 
 use englobe::{AccelKind, World, WorldError};
 use englobe_scene::Scene;

@@ -5,8 +5,9 @@
 //!
 //! On request the renderer also records the work of every pixel (the cost AOV, see
 //! [`crate::cost`]) and can render only a regular sample of the pixels (every `n`-th pixel of
-//! every `n`-th row), which times slow structures on large scenes; a pixel's value never depends
-//! on which other pixels are rendered.
+//! every `n`-th row), which times slow structures on large scenes, or only a window of the image
+//! (a tile of a render spread over several processes, see [`crate::tile`]); a pixel's value never
+//! depends on which other pixels are rendered.
 
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::time::Instant;
@@ -22,6 +23,7 @@ use crate::cost::CostImage;
 use crate::film::Film;
 use crate::path::PathTracer;
 use crate::stats::{RayKind, RenderStats, Tally};
+use crate::tile::PixelWindow;
 use crate::whitted::Whitted;
 
 /// Side of the square tiles, in pixels.
@@ -38,15 +40,18 @@ pub enum RenderError {
 /// What a render produced.
 #[derive(Clone, Debug)]
 pub struct RenderOutput {
-    /// The image.
+    /// The image: the window's pixels (the whole image unless [`Renderer::window`] asked for less).
     pub film: Film,
+    /// Where the film lies in the image.
+    pub window: PixelWindow,
     /// Rays and work per kind of ray (work is zero unless counting was asked for).
     pub stats: RenderStats,
     /// False if the render was cancelled before every tile was done (missing tiles are black).
     pub complete: bool,
     /// Wall-clock seconds spent rendering.
     pub seconds: f64,
-    /// Work per pixel (nodes visited plus exact tests), if [`Renderer::record_cost`] asked for it.
+    /// Work per pixel (nodes visited plus exact tests) over the window, if [`Renderer::record_cost`]
+    /// asked for it.
     pub cost: Option<CostImage>,
 }
 
@@ -60,6 +65,7 @@ pub struct Renderer<'a> {
     count_work: bool,
     record_cost: bool,
     stride: u32,
+    window: Option<PixelWindow>,
     progress: Option<&'a (dyn Fn(usize, usize) + Sync)>,
     cancel: Option<&'a AtomicBool>,
     integrator: IntegratorKind,
@@ -79,6 +85,7 @@ impl<'a> Renderer<'a> {
             count_work: false,
             record_cost: false,
             stride: 1,
+            window: None,
             progress: None,
             cancel: None,
             integrator: scene.image.integrator,
@@ -120,6 +127,13 @@ impl<'a> Renderer<'a> {
         self
     }
 
+    /// Renders only the pixels of `window` (checked to lie inside the image when the render
+    /// starts), into a film of the window's size; each has the value a full render gives it.
+    pub fn window(mut self, window: PixelWindow) -> Self {
+        self.window = Some(window);
+        self
+    }
+
     /// Overrides the scene's integrator.
     pub fn integrator(mut self, kind: IntegratorKind) -> Self {
         self.integrator = kind;
@@ -143,6 +157,9 @@ impl<'a> Renderer<'a> {
     pub fn render(&self) -> Result<RenderOutput, RenderError> {
         ImageSettings::check_limits(self.width, self.height, self.samples, self.scene.image.max_depth)
             .map_err(RenderError::Limits)?;
+        if let Some(w) = self.window {
+            w.check_inside(self.width, self.height).map_err(RenderError::Limits)?;
+        }
         if self.count_work || self.record_cost {
             Ok(self.render_with::<WorkCounts>())
         } else {
@@ -157,8 +174,15 @@ impl<'a> Renderer<'a> {
             IntegratorKind::Whitted => Integrator::Whitted(Whitted::new(self.scene, self.world)),
             IntegratorKind::Path => Integrator::Path(PathTracer::new(self.scene, self.world)),
         };
-        let tiles_x = self.width.div_ceil(TILE_SIZE);
-        let tiles_y = self.height.div_ceil(TILE_SIZE);
+        let window = self.window.unwrap_or(PixelWindow::full(self.width, self.height));
+        let tiles_x = window.width().div_ceil(TILE_SIZE);
+        let tiles_y = window.height().div_ceil(TILE_SIZE);
+        // Tile `index`'s pixels: the grid starts at the window's corner.
+        let tile_at = |index: usize| {
+            let (x0, y0) =
+                (window.x0 + (index as u32 % tiles_x) * TILE_SIZE, window.y0 + (index as u32 / tiles_x) * TILE_SIZE);
+            (x0, y0, (x0 + TILE_SIZE).min(window.x1), (y0 + TILE_SIZE).min(window.y1))
+        };
         let total = (tiles_x * tiles_y) as usize;
         let done = AtomicUsize::new(0);
         let cancelled = || self.cancel.is_some_and(|c| c.load(Ordering::Relaxed));
@@ -166,8 +190,7 @@ impl<'a> Renderer<'a> {
         let tiles: Vec<Option<TileOutput>> = (0..total)
             .into_par_iter()
             .map(|index| {
-                let (x0, y0) = ((index as u32 % tiles_x) * TILE_SIZE, (index as u32 / tiles_x) * TILE_SIZE);
-                let (x1, y1) = ((x0 + TILE_SIZE).min(self.width), (y0 + TILE_SIZE).min(self.height));
+                let (x0, y0, x1, y1) = tile_at(index);
                 let mut tally = Tally::<C>::default();
                 let area = ((x1 - x0) * (y1 - y0)) as usize;
                 let mut pixels = Vec::with_capacity(area);
@@ -202,8 +225,8 @@ impl<'a> Renderer<'a> {
             })
             .collect();
 
-        let mut film = Film::new(self.width, self.height);
-        let mut cost = self.record_cost.then(|| CostImage::new(self.width, self.height));
+        let mut film = Film::new(window.width(), window.height());
+        let mut cost = self.record_cost.then(|| CostImage::new(window.width(), window.height()));
         let mut stats = RenderStats::default();
         let mut complete = true;
         for (index, tile) in tiles.into_iter().enumerate() {
@@ -212,12 +235,11 @@ impl<'a> Renderer<'a> {
                 continue;
             };
             stats.add(&tile.stats);
-            let (x0, y0) = ((index as u32 % tiles_x) * TILE_SIZE, (index as u32 / tiles_x) * TILE_SIZE);
-            let x1 = (x0 + TILE_SIZE).min(self.width);
+            let (x0, y0, x1, y1) = tile_at(index);
             let mut it = tile.pixels.into_iter();
             let mut work = tile.cost.into_iter();
-            for y in y0..(y0 + TILE_SIZE).min(self.height) {
-                for x in x0..x1 {
+            for y in y0 - window.y0..y1 - window.y0 {
+                for x in x0 - window.x0..x1 - window.x0 {
                     film.set(x, y, it.next().expect("a tile holds all its pixels"));
                     if let Some(cost) = cost.as_mut() {
                         cost.set(x, y, work.next().expect("a tile holds the cost of all its pixels"));
@@ -225,7 +247,7 @@ impl<'a> Renderer<'a> {
                 }
             }
         }
-        RenderOutput { film, stats, complete, seconds: start.elapsed().as_secs_f64(), cost }
+        RenderOutput { film, window, stats, complete, seconds: start.elapsed().as_secs_f64(), cost }
     }
 
     fn pixel<C: Counters>(
