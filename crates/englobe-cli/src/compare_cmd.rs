@@ -9,7 +9,8 @@ use clap::Args;
 use englobe::AccelKind;
 use englobe_lab::{CompareOptions, run_compare};
 
-use crate::render_cmd::{parse_accel, read_scene};
+use crate::image_options::parse_accel;
+use crate::render_cmd::read_scene;
 
 #[derive(Args)]
 pub struct CompareArgs {

@@ -9,7 +9,7 @@ use clap::{Args, ValueEnum};
 use englobe::AccelKind;
 use englobe_lab::{SeedOptions, run_seed};
 
-use crate::render_cmd::parse_accel;
+use crate::image_options::parse_accel;
 
 /// The experiments `englobe experiment` runs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]

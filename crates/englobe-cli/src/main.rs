@@ -3,13 +3,17 @@
 //! libraries (`bench`, forwarded to englobe-bench when built with the `bench` feature). Each
 //! command's file parses its arguments and calls the library crates.
 
+mod assemble_cmd;
 mod bench_cmd;
 mod compare_cmd;
 mod experiment_cmd;
+mod farm_cmd;
+mod image_options;
 mod info_cmd;
 mod interrupt;
 mod progress;
 mod render_cmd;
+mod slurm;
 
 use std::process::ExitCode;
 
@@ -25,8 +29,14 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Render a scene file (or the embedded default scene) to PNG or EXR.
+    /// Render a scene file (or the embedded default scene) to PNG or EXR, or one tile of it.
     Render(render_cmd::RenderArgs),
+    /// Put tiles rendered with `render --tile` or `--pixel-bounds` together into one image,
+    /// byte-identical to a single render; refuses missing, overlapping or foreign tiles.
+    Assemble(assemble_cmd::AssembleArgs),
+    /// Render one image on a cluster: `farm slurm` submits one Slurm job array of tiles, waits,
+    /// and assembles; run again, it renders only the tiles still missing.
+    Farm(farm_cmd::FarmArgs),
     /// Run an experiment: `seed` renders the seed report's four tests with every accelerator and
     /// prints its table beside the report's figures.
     Experiment(experiment_cmd::ExperimentArgs),
@@ -45,6 +55,8 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Render(args) => render_cmd::run(args),
+        Command::Assemble(args) => assemble_cmd::run(args),
+        Command::Farm(args) => farm_cmd::run(args),
         Command::Experiment(args) => experiment_cmd::run(args),
         Command::Compare(args) => compare_cmd::run(args),
         Command::Info(args) => info_cmd::run(args),

@@ -1,4 +1,5 @@
-//! `englobe render`: one scene to one image, with optional statistics.
+//! `englobe render`: one scene to one image, with optional statistics, or one piece of an image
+//! (`--tile K/N`, `--pixel-bounds`) written as an OpenEXR tile for `englobe assemble`.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -6,12 +7,13 @@ use std::time::Instant;
 
 use anyhow::Context;
 use clap::{Args, ValueEnum};
-use englobe::AccelKind;
 use englobe_lab::memory::peak_rss_bytes;
 use englobe_lab::report::{StatsReport, stats_table, write_json};
-use englobe_render::{HeatmapScale, Renderer, build_world, write_cost_image, write_image};
-use englobe_scene::{IntegratorKind, Scene, load_scene, parse_scene};
+use englobe_render::tile::file::{TileHeader, VERSION, write_tile};
+use englobe_render::{HeatmapScale, PixelWindow, Renderer, TileSpec, build_world, write_cost_image, write_image};
+use englobe_scene::{Scene, load_scene, parse_scene};
 
+use crate::image_options::{ImageOptions, render_digest};
 use crate::interrupt;
 use crate::progress::tile_bar;
 
@@ -19,29 +21,22 @@ use crate::progress::tile_bar;
 pub struct RenderArgs {
     /// Scene file (TOML, see docs/scene-format.md); the embedded default scene if omitted.
     scene: Option<PathBuf>,
-    /// Output image (.png or .exr); defaults to the scene's name with .png, in the current folder.
+    /// Output image (.png or .exr); defaults to the scene's name with .png, in the current folder
+    /// (with --tile or --pixel-bounds: an .exr tile, named after the scene and the tile).
     #[arg(short, long)]
     output: Option<PathBuf>,
-    /// Image width in pixels (overrides the scene).
-    #[arg(long)]
-    width: Option<u32>,
-    /// Image height in pixels (overrides the scene).
-    #[arg(long)]
-    height: Option<u32>,
-    /// Samples per pixel (overrides the scene).
-    #[arg(long)]
-    spp: Option<u32>,
+    #[command(flatten)]
+    image: ImageOptions,
+    /// Render only tile K of N (from 0): the K-th of N horizontal strips, written as an OpenEXR
+    /// tile for `englobe assemble`.
+    #[arg(long, value_name = "K/N", conflicts_with = "pixel_bounds")]
+    tile: Option<TileSpec>,
+    /// Render only columns X0..X1 and rows Y0..Y1 (half-open), written as an OpenEXR tile.
+    #[arg(long, value_name = "X0,X1,Y0,Y1")]
+    pixel_bounds: Option<PixelWindow>,
     /// Worker threads (default: all cores).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
     threads: Option<u32>,
-    /// Acceleration structure: bvh-wide (the fast path, eight-wide at both levels), none (brute
-    /// force), bvh-seed, bvh-seed-ordered, bvh-sah, bvh-ploc, bvh-sweep, kdtree, grid
-    #[arg(long, default_value = "bvh-wide", value_parser = parse_accel)]
-    accel: AccelKind,
-    /// Light transport: whitted (the seed's recursion) or path (Monte Carlo path tracing);
-    /// overrides the scene's `integrator`.
-    #[arg(long, value_parser = parse_integrator)]
-    integrator: Option<IntegratorKind>,
     /// What the image shows: the shaded scene (color), or the structure's work per pixel (cost:
     /// nodes visited plus exact tests, in false colour with a colour bar; raw counts in .exr).
     #[arg(long, value_enum, default_value_t = Aov::Color)]
@@ -82,18 +77,6 @@ pub enum CostScale {
     Linear,
 }
 
-fn parse_integrator(s: &str) -> Result<IntegratorKind, String> {
-    match s {
-        "whitted" => Ok(IntegratorKind::Whitted),
-        "path" => Ok(IntegratorKind::Path),
-        _ => Err(format!("unknown integrator `{s}`; expected whitted or path")),
-    }
-}
-
-pub fn parse_accel(s: &str) -> Result<AccelKind, String> {
-    s.parse().map_err(|e: englobe::accel::UnknownAccel| e.to_string())
-}
-
 /// The scene of the command line, or the embedded default, with its display name.
 pub fn read_scene(path: Option<&PathBuf>) -> anyhow::Result<(Scene, String)> {
     match path {
@@ -104,24 +87,46 @@ pub fn read_scene(path: Option<&PathBuf>) -> anyhow::Result<(Scene, String)> {
 
 pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
     let interrupted = interrupt::install()?;
-    let (scene, scene_name) = read_scene(args.scene.as_ref())?;
+    let (mut scene, scene_name) = read_scene(args.scene.as_ref())?;
     if !args.quiet {
         for w in &scene.warnings {
             eprintln!("warning: {w}");
         }
     }
-    let width = args.width.unwrap_or(scene.image.width);
-    let height = args.height.unwrap_or(scene.image.height);
-    let samples = args.spp.unwrap_or(scene.image.samples);
-    let integrator = args.integrator.unwrap_or(scene.image.integrator);
-    let output = args.output.clone().unwrap_or_else(|| {
-        let stem = args.scene.as_ref().and_then(|p| p.file_stem()).map_or("englobe".into(), |s| s.to_os_string());
-        PathBuf::from(stem).with_extension("png")
+    args.image.apply(&mut scene);
+    let accel = args.image.accel;
+    let (width, height, samples, integrator) =
+        (scene.image.width, scene.image.height, scene.image.samples, scene.image.integrator);
+    let piece = match (args.tile, args.pixel_bounds) {
+        (Some(tile), _) => Some((tile.window(width, height).map_err(anyhow::Error::msg)?, Some(tile))),
+        (None, Some(window)) => {
+            window.check_inside(width, height).map_err(anyhow::Error::msg)?;
+            Some((window, None))
+        }
+        (None, None) => None,
+    };
+    let stem =
+        args.scene.as_ref().and_then(|p| p.file_stem()).map_or("englobe".into(), |s| s.to_string_lossy().into_owned());
+    let output = args.output.clone().unwrap_or_else(|| match piece {
+        Some((_, Some(tile))) => PathBuf::from(format!("{stem}.tile-{}-of-{}.exr", tile.index, tile.count)),
+        Some((w, None)) => PathBuf::from(format!("{stem}.window-{}-{}-{}-{}.exr", w.x0, w.x1, w.y0, w.y1)),
+        None => PathBuf::from(stem).with_extension("png"),
     });
-    englobe_render::OutputFormat::from_path(&output)?;
+    let format = englobe_render::OutputFormat::from_path(&output)?;
+    if piece.is_some() {
+        anyhow::ensure!(
+            format == englobe_render::OutputFormat::Exr,
+            "{}: a tile is written as OpenEXR (.exr), so that `englobe assemble` gets the exact values",
+            output.display()
+        );
+        anyhow::ensure!(
+            args.aov == Aov::Color,
+            "--aov cost cannot be tiled: its colour scale depends on the whole image"
+        );
+    }
 
     let build_start = Instant::now();
-    let world = build_world(&scene, args.accel).context("cannot build the acceleration structure")?;
+    let world = build_world(&scene, accel).context("cannot build the acceleration structure")?;
     let build_seconds = build_start.elapsed().as_secs_f64();
 
     let pool = rayon::ThreadPoolBuilder::new()
@@ -129,15 +134,14 @@ pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
         .build()
         .context("cannot start the worker threads")?;
     let count_work = args.stats || args.stats_json.is_some();
-    let tiles = width.div_ceil(englobe_render::render::TILE_SIZE) as usize
-        * height.div_ceil(englobe_render::render::TILE_SIZE) as usize;
+    let window = piece.map_or(PixelWindow::full(width, height), |(w, _)| w);
+    let tiles = window.width().div_ceil(englobe_render::render::TILE_SIZE) as usize
+        * window.height().div_ceil(englobe_render::render::TILE_SIZE) as usize;
     let bar = tile_bar(tiles, args.quiet);
     let progress = |done: usize, _total: usize| bar.set_position(done as u64);
     let out = pool.install(|| {
         Renderer::new(&scene, &world)
-            .size(width, height)
-            .samples(samples)
-            .integrator(integrator)
+            .window(window)
             .count_work(count_work)
             .record_cost(args.aov == Aov::Cost)
             .on_progress(&progress)
@@ -154,7 +158,19 @@ pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
         return Ok(ExitCode::from(interrupt::INTERRUPTED_EXIT_CODE));
     }
 
+    if let Some((window, tile)) = piece {
+        let header = TileHeader {
+            full_width: width,
+            full_height: height,
+            window,
+            scene_digest: render_digest(&scene, accel),
+            version: VERSION.to_owned(),
+            tile,
+        };
+        write_tile(&output, &header, &out.film)?;
+    }
     let scale = match &out.cost {
+        _ if piece.is_some() => None,
         Some(cost) => {
             let max = args.cost_max.unwrap_or_else(|| cost.max());
             let scale = match args.cost_scale {
@@ -172,11 +188,16 @@ pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
         if let Some(scale) = scale {
             println!("{}", scale.describe());
         }
+        let what = match piece {
+            Some((w, Some(tile))) => format!("tile {tile}, pixels {w} of {width}x{height}"),
+            Some((w, None)) => format!("pixels {w} of {width}x{height}"),
+            None => format!("{width}x{height}"),
+        };
         println!(
-            "wrote {} ({width}x{height}, {samples} spp, {}, accel {}, {:.2} s on {} threads)",
+            "wrote {} ({what}, {samples} spp, {}, accel {}, {:.2} s on {} threads)",
             output.display(),
             integrator.name(),
-            args.accel,
+            accel,
             out.seconds,
             pool.current_num_threads()
         );
@@ -192,7 +213,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
     if let Some(path) = &args.stats_json {
         let report = StatsReport {
             scene: &scene_name,
-            accel: args.accel.name(),
+            accel: accel.name(),
             width,
             height,
             samples,
