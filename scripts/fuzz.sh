@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Coverage-guided fuzzing of the scene parser and each mesh loader with cargo fuzz (libFuzzer).
+# Coverage-guided fuzzing of the scene parser, each mesh loader and the tile reader with cargo fuzz
+# (libFuzzer).
 #
 #   scripts/fuzz.sh [SECONDS_PER_TARGET] [TARGET...]
 #
@@ -13,7 +14,7 @@ cd "$(dirname "$0")/.."
 seconds=${1:-60}
 shift || true
 targets=("$@")
-[ ${#targets[@]} -gt 0 ] || targets=(scene_toml mesh_obj mesh_ply mesh_gltf)
+[ ${#targets[@]} -gt 0 ] || targets=(scene_toml mesh_obj mesh_ply mesh_gltf tile_exr)
 shared=${ENGLOBE_SHARED:-../shared}
 
 seed() {
@@ -24,6 +25,11 @@ seed() {
         mesh_obj) find "$shared/scenes/meshes" -name '*.obj' -size -200k -exec cp {} "$dir/" \; ;;
         mesh_ply) find "$shared/scenes/meshes" -name '*.ply' -size -2M -exec cp {} "$dir/" \; ;;
         mesh_gltf) find "$shared/scenes/meshes" \( -name '*.gltf' -o -name '*.glb' \) -size -2M -exec cp {} "$dir/" \; ;;
+        tile_exr)
+            for t in 0/1 1/3; do
+                cargo run -q -- render --width 16 --height 9 --spp 1 --tile "$t" -o "$dir/tile-${t%/*}.exr" -q
+            done
+            ;;
     esac
 }
 
