@@ -25,6 +25,8 @@ SCENE=$(realpath scenes/cornell-box-path.toml)
 # while it runs.
 OPTS=(--width 128 --height 96 --spp 512)
 
+START=$(date +%s.%N)
+elapsed() { python3 -c "import sys; print(f'{float(sys.argv[2]) - float(sys.argv[1]):.1f}')" "$START" "$(date +%s.%N)"; }
 D=$(mktemp -d /tmp/englobe-slurm.XXXXXX)
 PIDFILES=("$D/slurmd.pid" "$D/slurmctld.pid" "$D/munge/munged.pid")
 cleanup() {
@@ -95,7 +97,7 @@ for _ in $(seq 300); do
     sleep 0.2
 done
 [ "$(sinfo -h -o %T)" = idle ] || { echo "slurm-e2e: the node did not come up" >&2; exit 1; }
-echo "slurm-e2e: cluster up ($CPUS cores) in $D"
+echo "slurm-e2e: cluster up ($CPUS cores) after $(elapsed) s, in $D"
 
 cd "$D/work"
 "$ENGLOBE" render "$SCENE" "${OPTS[@]}" -o one.png -q
@@ -135,4 +137,4 @@ grep -q "submitted job .*: 1 of 8 tiles ($INDEX)" second.log
 cmp one.png out.png
 "$ENGLOBE" assemble out.png.tiles -o out.exr
 cmp one.exr out.exr
-echo "slurm-e2e: OK: task $CANCELLED cancelled, resumed, image byte-identical to one render (PNG and EXR)"
+echo "slurm-e2e: OK after $(elapsed) s: task $CANCELLED cancelled, resumed, image byte-identical to one render (PNG and EXR)"

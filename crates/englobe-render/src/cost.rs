@@ -5,10 +5,10 @@
 
 use std::path::Path;
 
-use image::{ImageFormat, Rgb32FImage};
+use image::ImageFormat;
 
 use crate::heatmap::{Heatmap, HeatmapScale};
-use crate::output::{OutputError, OutputFormat, write_atomically};
+use crate::output::{OutputError, OutputFormat, write_atomically, write_exr_rgb};
 
 /// Work per pixel, row by row from the top.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -71,10 +71,8 @@ pub fn write_cost_image(cost: &CostImage, path: &Path, scale: HeatmapScale) -> R
                 Heatmap::new(cost.width(), cost.height(), cost.values(), scale).to_rgb8().write_to(w, ImageFormat::Png)
             }
             OutputFormat::Exr => {
-                let raw = cost.values().iter().flat_map(|&v| [v as f32; 3]).collect();
-                Rgb32FImage::from_raw(cost.width(), cost.height(), raw)
-                    .expect("the cost image holds exactly width * height values")
-                    .write_to(w, ImageFormat::OpenExr)
+                let values = cost.values();
+                return write_exr_rgb(w, path, cost.width(), cost.height(), |i| [values[i] as f32; 3]);
             }
         };
         result.map_err(|source| OutputError::Encode { path: path.to_owned(), source })

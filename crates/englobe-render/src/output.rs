@@ -1,11 +1,15 @@
 //! Writing images: PNG (8-bit sRGB) or OpenEXR (linear float), always atomically: the image is
 //! written to a temporary file in the destination's folder and renamed over the destination, so
-//! an interrupted run never leaves a half-written file where a good image was.
+//! an interrupted run never leaves a half-written file where a good image was. The same film
+//! always gives the same bytes: EXR blocks are compressed in parallel but written in increasing
+//! order (an EXR's "unspecified" line order, the `exr` crate's default, writes them in whatever
+//! order the threads finish).
 
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
-use image::{ImageFormat, Rgb32FImage, RgbImage};
+use exr::prelude::{Blocks, Compression, Encoding, Image, LineOrder, SpecificChannels, Vec2, WritableImage};
+use image::{ImageFormat, RgbImage};
 
 use crate::film::Film;
 
@@ -33,6 +37,15 @@ pub enum OutputError {
         #[source]
         source: image::ImageError,
     },
+    /// The OpenEXR encoder failed.
+    #[error("{}: cannot encode: {source}", path.display())]
+    EncodeExr {
+        /// The destination.
+        path: PathBuf,
+        /// The cause.
+        #[source]
+        source: exr::error::Error,
+    },
 }
 
 /// The image formats englobe writes.
@@ -55,6 +68,11 @@ impl OutputFormat {
     }
 }
 
+/// How englobe writes OpenEXR: ZIP compression of 16 scan lines at a time (lossless for floats),
+/// blocks in increasing order, so that the bytes depend on the pixels alone.
+pub const EXR_ENCODING: Encoding =
+    Encoding { compression: Compression::ZIP16, blocks: Blocks::ScanLines, line_order: LineOrder::Increasing };
+
 /// Writes the film to `path` (format from the extension), atomically.
 pub fn write_image(film: &Film, path: &Path) -> Result<(), OutputError> {
     let format = OutputFormat::from_path(path)?;
@@ -64,12 +82,33 @@ pub fn write_image(film: &Film, path: &Path) -> Result<(), OutputError> {
             OutputFormat::Png => RgbImage::from_raw(wd, ht, film.to_srgb8())
                 .expect("the film holds exactly width * height pixels")
                 .write_to(w, ImageFormat::Png),
-            OutputFormat::Exr => Rgb32FImage::from_raw(wd, ht, film.to_linear_f32())
-                .expect("the film holds exactly width * height pixels")
-                .write_to(w, ImageFormat::OpenExr),
+            OutputFormat::Exr => {
+                let pixels = film.pixels();
+                return write_exr_rgb(w, path, wd, ht, |i| pixels[i].to_array());
+            }
         };
         result.map_err(|source| OutputError::Encode { path: path.to_owned(), source })
     })
+}
+
+/// Encodes a `width` x `height` RGB float image as OpenEXR with [`EXR_ENCODING`]; `pixel(i)` is
+/// the `i`-th pixel, row by row. `path` names the destination in errors.
+pub fn write_exr_rgb(
+    w: impl std::io::Write + std::io::Seek,
+    path: &Path,
+    width: u32,
+    height: u32,
+    pixel: impl Sync + Fn(usize) -> [f32; 3],
+) -> Result<(), OutputError> {
+    let width = width as usize;
+    let channels = SpecificChannels::rgb(|p: Vec2<usize>| {
+        let [r, g, b] = pixel(p.y() * width + p.x());
+        (r, g, b)
+    });
+    Image::from_encoded_channels((width, height as usize), EXR_ENCODING, channels)
+        .write()
+        .to_buffered(w)
+        .map_err(|source| OutputError::EncodeExr { path: path.to_owned(), source })
 }
 
 /// Runs `write` on a temporary file beside `path`, then renames it to `path`. On any error the
@@ -141,6 +180,28 @@ mod tests {
         write_image(&film, &path).unwrap();
         let img = image::open(&path).unwrap().to_rgb32f();
         assert_eq!(img.get_pixel(0, 1).0, [4.5, 0.25, 0.0]);
+    }
+
+    #[test]
+    fn exr_bytes_depend_on_the_pixels_alone() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut film = Film::new(300, 200);
+        for y in 0..200 {
+            for x in 0..300 {
+                film.set(x, y, englobe::Vec3::new((x * y) as f32 * 1e-3, (x ^ y) as f32, 1.0 / (1 + x + y) as f32));
+            }
+        }
+        let bytes: Vec<Vec<u8>> = (0..4)
+            .map(|i| {
+                let path = dir.path().join(format!("{i}.exr"));
+                write_image(&film, &path).unwrap();
+                std::fs::read(path).unwrap()
+            })
+            .collect();
+        assert!(bytes.iter().all(|b| *b == bytes[0]));
+        // Blocks compressed on several threads land in increasing order, not as they finish.
+        let meta = exr::meta::MetaData::read_from_file(dir.path().join("0.exr"), false).unwrap();
+        assert_eq!(meta.headers[0].line_order, LineOrder::Increasing);
     }
 
     #[test]

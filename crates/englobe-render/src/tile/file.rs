@@ -9,14 +9,11 @@ use std::path::{Path, PathBuf};
 
 use englobe::Vec3;
 use exr::meta::attribute::{AttributeValue, IntegerBounds, SampleType, Text};
-use exr::prelude::{
-    Blocks, Compression, Encoding, Image, Layer, LayerAttributes, LineOrder, ReadChannels, ReadLayers,
-    SpecificChannels, Vec2, WritableImage,
-};
+use exr::prelude::{Image, Layer, LayerAttributes, ReadChannels, ReadLayers, SpecificChannels, Vec2, WritableImage};
 
 use super::{PixelWindow, TileSpec};
 use crate::film::Film;
-use crate::output::{OutputError, write_atomically};
+use crate::output::{EXR_ENCODING, OutputError, write_atomically};
 
 /// The version of englobe that tiles record and assembly compares.
 pub const VERSION: &str = env!("CARGO_PKG_VERSION");
@@ -98,9 +95,7 @@ pub fn write_tile(path: &Path, header: &TileHeader, film: &Film) -> Result<(), T
     if let Some(tile) = header.tile {
         text(TILE_KEY, tile.to_string());
     }
-    let encoding =
-        Encoding { compression: Compression::ZIP16, blocks: Blocks::ScanLines, line_order: LineOrder::Increasing };
-    let layer = Layer::new((width, film.height() as usize), attributes, encoding, channels);
+    let layer = Layer::new((width, film.height() as usize), attributes, EXR_ENCODING, channels);
     let mut image = Image::from_layer(layer);
     image.attributes.display_window =
         IntegerBounds::new((0, 0), (header.full_width as usize, header.full_height as usize));
