@@ -18,7 +18,7 @@ use englobe_render::tile::assemble::{Tile, assemble};
 use englobe_render::tile::file::{VERSION, read_tile};
 use englobe_render::{TileSpec, write_image};
 
-use crate::image_options::{ImageOptions, render_digest};
+use crate::image_options::{Balance, ImageOptions, render_digest};
 use crate::render_cmd::read_scene;
 use crate::slurm::{self, Submission, shell_quote};
 
@@ -66,6 +66,11 @@ struct SlurmArgs {
     /// error rather than the start of a new one.
     #[arg(long)]
     resume: bool,
+    /// How the image is cut: strips of equal height (area) or of equal predicted cost (cost: every
+    /// task first makes a quick pass of the cost AOV, so that the slowest task is not much slower
+    /// than the mean).
+    #[arg(long, value_enum, default_value_t = Balance::Area)]
+    balance: Balance,
     /// Seconds between two looks at the queue.
     #[arg(long, default_value_t = 2.0, value_name = "SECONDS")]
     poll: f64,
@@ -176,7 +181,8 @@ fn run_slurm(args: SlurmArgs) -> anyhow::Result<ExitCode> {
         name.push(".tiles");
         PathBuf::from(name)
     });
-    let plan = Plan { dir, digest: render_digest(&scene, args.image.accel), width, height, count: args.tiles };
+    let plan =
+        Plan { dir, digest: render_digest(&scene, args.image.accel, args.balance), width, height, count: args.tiles };
     let earlier_run = plan.jobs_file().exists() || plan.survey().is_ok_and(|(done, _)| !done.is_empty());
     if args.resume && !earlier_run {
         bail!("{}: no earlier run to resume (no tiles, no jobs file)", plan.dir.display());
@@ -275,6 +281,9 @@ fn write_script(path: &Path, args: &SlurmArgs, plan: &Plan, dir: &Path) -> anyho
     render.push(format!("-o {}/tile-$(printf %0{digits}d \"$k\").exr", shell_quote(&dir.to_string_lossy())));
     render.push("--threads \"${SLURM_CPUS_PER_TASK:-1}\"".to_owned());
     render.extend(args.image.to_args().iter().map(|a| shell_quote(a)));
+    if args.balance == Balance::Cost {
+        render.push("--balance cost".to_owned());
+    }
     let text = format!(
         "#!/bin/bash\n\
          # Written by `englobe farm slurm`: array task K renders tile K of {count}; submitted by\n\

@@ -2,7 +2,7 @@
 //! size, samples, integrator and structure overrides, applied to the scene, and the digest that
 //! tiles record of the result (see englobe-render's `tile` module).
 
-use clap::Args;
+use clap::{Args, ValueEnum};
 use englobe::AccelKind;
 use englobe_scene::{IntegratorKind, Scene};
 
@@ -54,9 +54,25 @@ impl ImageOptions {
     }
 }
 
-/// The digest of the pixels `scene` (with the overrides applied) gives under `accel`.
-pub fn render_digest(scene: &Scene, accel: AccelKind) -> String {
-    englobe_render::digest::scene_digest(scene, &format!("accel={} aov=color", accel.name()))
+/// How `--tile K/N` cuts the image into strips.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
+pub enum Balance {
+    /// Strips of equal height.
+    #[default]
+    Area,
+    /// Strips of equal predicted cost, from a first pass of the cost AOV on every 4th pixel of
+    /// every 4th row (each task makes the same pass, so all agree on the cut).
+    Cost,
+}
+
+/// The digest of the pixels `scene` (with the overrides applied) gives under `accel`, cut as
+/// `balance` says (tiles of different cuts must not be mixed).
+pub fn render_digest(scene: &Scene, accel: AccelKind, balance: Balance) -> String {
+    let balance = balance.to_possible_value().expect("no variant is skipped");
+    englobe_render::digest::scene_digest(
+        scene,
+        &format!("accel={} aov=color balance={}", accel.name(), balance.get_name()),
+    )
 }
 
 fn parse_integrator(s: &str) -> Result<IntegratorKind, String> {

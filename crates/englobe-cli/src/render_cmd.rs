@@ -13,7 +13,7 @@ use englobe_render::tile::file::{TileHeader, VERSION, write_tile};
 use englobe_render::{HeatmapScale, PixelWindow, Renderer, TileSpec, build_world, write_cost_image, write_image};
 use englobe_scene::{Scene, load_scene, parse_scene};
 
-use crate::image_options::{ImageOptions, render_digest};
+use crate::image_options::{Balance, ImageOptions, render_digest};
 use crate::interrupt;
 use crate::progress::tile_bar;
 
@@ -31,6 +31,9 @@ pub struct RenderArgs {
     /// tile for `englobe assemble`.
     #[arg(long, value_name = "K/N", conflicts_with = "pixel_bounds")]
     tile: Option<TileSpec>,
+    /// How --tile cuts the image: strips of equal height (area) or of equal predicted cost (cost).
+    #[arg(long, value_enum, default_value_t = Balance::Area, requires = "tile")]
+    balance: Balance,
     /// Render only columns X0..X1 and rows Y0..Y1 (half-open), written as an OpenEXR tile.
     #[arg(long, value_name = "X0,X1,Y0,Y1")]
     pixel_bounds: Option<PixelWindow>,
@@ -134,6 +137,13 @@ pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
         .build()
         .context("cannot start the worker threads")?;
     let count_work = args.stats || args.stats_json.is_some();
+    let piece = match piece {
+        Some((_, Some(tile))) if args.balance == Balance::Cost => {
+            let costs = pool.install(|| englobe_render::tile::balance::predict_row_costs(&scene, &world))?;
+            Some((tile.balanced_window(width, &costs).map_err(anyhow::Error::msg)?, Some(tile)))
+        }
+        other => other,
+    };
     let window = piece.map_or(PixelWindow::full(width, height), |(w, _)| w);
     let tiles = window.width().div_ceil(englobe_render::render::TILE_SIZE) as usize
         * window.height().div_ceil(englobe_render::render::TILE_SIZE) as usize;
@@ -163,7 +173,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
             full_width: width,
             full_height: height,
             window,
-            scene_digest: render_digest(&scene, accel),
+            scene_digest: render_digest(&scene, accel, args.balance),
             version: VERSION.to_owned(),
             tile,
         };

@@ -75,6 +75,22 @@ fn one_four_and_seven_tiles_assemble_to_the_bytes_of_one_render() {
             assert_eq!(std::fs::read(d.join(&out)).unwrap(), std::fs::read(d.join(format!("one.{ext}"))).unwrap());
         }
     }
+    // Strips cut by predicted cost too.
+    for count in [4, 7] {
+        let t: Vec<String> = (0..count)
+            .map(|k| {
+                let name = format!("c{k}-of-{count}.exr");
+                render(d, &["--tile", &format!("{k}/{count}"), "--balance", "cost", "-o", &name]);
+                name
+            })
+            .collect();
+        ok(assemble(d, &t, "balanced.png"));
+        assert_eq!(std::fs::read(d.join("balanced.png")).unwrap(), std::fs::read(d.join("one.png")).unwrap());
+        // Mixed with strips cut by area, they are another render's.
+        let mixed = [t[0].clone(), format!("t1-of-{count}.exr")];
+        render(d, &["--tile", &format!("1/{count}"), "-o", &mixed[1]]);
+        assert!(failure(assemble(d, &mixed, "x.png")).contains("different renders"));
+    }
     // Any windows that cover the image once do too.
     for w in ["0,20,0,36", "20,48,0,10", "20,48,10,36"] {
         render(d, &["--pixel-bounds", w, "-o", &format!("w{w}.exr")]);
@@ -210,4 +226,15 @@ fn farm_renders_every_tile_then_only_the_missing_ones() {
         &[("FAKE_SLURM_LOG", &log_s)],
     ));
     assert!(e.contains("tile-0000.exr: a tile of another render"), "{e}");
+
+    // Cut by cost, in a folder of its own: the tasks are told to cut the same way.
+    let o = ok(englobe_env(
+        d,
+        &[&farm[..6], &["balanced.png", "--balance", "cost", "--tiles-dir", "balanced"], &farm[7..]].concat(),
+        Some(&bin),
+        &[("FAKE_SLURM_LOG", &log_s)],
+    ));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("wrote balanced.png"));
+    assert!(std::fs::read_to_string(d.join("balanced/job.sbatch")).unwrap().contains("--balance cost"));
+    assert_eq!(std::fs::read(d.join("balanced.png")).unwrap(), std::fs::read(d.join("one.png")).unwrap());
 }

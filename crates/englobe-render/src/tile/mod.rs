@@ -1,6 +1,7 @@
 //! Rendering an image in pieces: a [`PixelWindow`] is any rectangle of the image, a [`TileSpec`]
-//! (`K/N`) is the `K`-th of `N` horizontal strips that englobe cuts, and [`file`] and
-//! [`assemble`] write such a piece as an OpenEXR tile and put the pieces back together.
+//! (`K/N`) is the `K`-th of `N` horizontal strips that englobe cuts (of equal height, or of equal
+//! predicted cost: [`balance`]), and [`file`] and [`assemble`] write such a piece as an OpenEXR
+//! tile and put the pieces back together.
 //!
 //! The design follows pbrt-v4's `--pixelbounds` and `imgtool assemble`: a piece holds exactly the
 //! values a full render gives its pixels (every pixel's samples depend on the seed and the pixel
@@ -10,6 +11,7 @@
 //! version, and assembly refuses tiles of different renders, overlaps and gaps.
 
 pub mod assemble;
+pub mod balance;
 pub mod file;
 
 use std::fmt;
