@@ -238,3 +238,36 @@ fn farm_renders_every_tile_then_only_the_missing_ones() {
     assert!(std::fs::read_to_string(d.join("balanced/job.sbatch")).unwrap().contains("--balance cost"));
     assert_eq!(std::fs::read(d.join("balanced.png")).unwrap(), std::fs::read(d.join("one.png")).unwrap());
 }
+
+#[test]
+fn farm_waits_for_an_earlier_job_still_queued_before_submitting() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let bin = fake_slurm(d);
+    // An earlier run's job 77 still shows a running task for the first three looks at the queue:
+    // its tile appears meanwhile, so only the others are submitted once it is gone.
+    let squeue = r#"#!/bin/bash
+n=$(cat "$FAKE_SQUEUE_COUNT" 2>/dev/null || echo 0)
+echo $((n + 1)) > "$FAKE_SQUEUE_COUNT"
+case "$*" in *77*) ;; *) exit 0 ;; esac
+if [ "$n" -lt 3 ]; then echo "77_1 RUNNING"; else exit 0; fi
+"#;
+    std::fs::write(bin.join("squeue"), squeue).unwrap();
+    let log = d.join("submissions");
+    let count = d.join("looks");
+    let s = scene();
+    let mut farm: Vec<&str> = vec!["farm", "slurm", &s, "--tiles", "3", "-o", "out.png", "--poll", "0.05"];
+    farm.extend(SIZE);
+    std::fs::create_dir_all(d.join("out.png.tiles")).unwrap();
+    std::fs::write(d.join("out.png.tiles/jobs"), "77\n").unwrap();
+    render(d, &["--tile", "1/3", "-o", "out.png.tiles/tile-0001.exr"]);
+    let env = [("FAKE_SLURM_LOG", log.to_str().unwrap()), ("FAKE_SQUEUE_COUNT", count.to_str().unwrap())];
+    let o = ok(englobe_env(d, &[farm.as_slice(), &["--resume"]].concat(), Some(&bin), &env));
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(text.contains("waiting for the tasks still queued from job 77"), "{text}");
+    assert!(text.contains("submitted job 101: 2 of 3 tiles (0,2)"), "{text}");
+    let looks: u32 = std::fs::read_to_string(&count).unwrap().trim().parse().unwrap();
+    assert!(looks >= 4, "the queue was looked at until job 77 was gone ({looks} looks)");
+    render(d, &["-o", "one.png"]);
+    assert_eq!(std::fs::read(d.join("out.png")).unwrap(), std::fs::read(d.join("one.png")).unwrap());
+}
