@@ -1,8 +1,8 @@
 //! The slab test of a wide node's eight children at once, one implementation per instruction set
 //! (see [`super::isa`]). Each computes, per child, exactly what the scalar robust slab test
 //! computes ([`super::node::child_entry_scalar`], Williams, Barrus, Morley and Shirley (2005) with
-//! the far distance scaled as in Ize (2013), "Robust BVH Ray Traversal"): the same subtractions and
-//! products in the same order, and the same handling of NaN (an origin on the plane of a parallel
+//! the far distance scaled as in Ize (2013), "Robust BVH Ray Traversal", the scale folded into the
+//! ray's inverse direction): the same subtractions and products in the same order, and the same handling of NaN (an origin on the plane of a parallel
 //! ray leaves the interval unchanged). The x86 `max`/`min` instructions return their second operand
 //! when either is NaN, which is the scalar test's `if t_near > enter { t_near } else { enter }`;
 //! the portable kernel spells that comparison out, because NEON's `max` propagates NaN instead.
@@ -14,7 +14,6 @@
 use glam::Vec4;
 
 use super::node::{NodeRay, WIDTH, WideNode};
-use crate::geom::aabb::ROBUST_FAR_SCALE;
 
 /// A slab test of all children of a node.
 pub trait NodeKernel: Copy {
@@ -41,7 +40,7 @@ impl NodeKernel for Portable {
             for a in 0..3 {
                 let (o, inv) = (Vec4::splat(ray.origin[a]), Vec4::splat(ray.inv_dir[a]));
                 let t_near = (row(ray.near[a]) - o) * inv;
-                let t_far = (row(ray.far[a]) - o) * inv * ROBUST_FAR_SCALE;
+                let t_far = (row(ray.far[a]) - o) * Vec4::splat(ray.inv_far[a]);
                 enter = Vec4::select(t_near.cmpgt(enter), t_near, enter);
                 exit = Vec4::select(t_far.cmplt(exit), t_far, exit);
             }
@@ -59,7 +58,7 @@ pub use x86::{Avx2, Avx512};
 mod x86 {
     use std::arch::x86_64::*;
 
-    use super::{NodeKernel, NodeRay, ROBUST_FAR_SCALE, WIDTH, WideNode};
+    use super::{NodeKernel, NodeRay, WIDTH, WideNode};
 
     /// Eight lanes with AVX2.
     #[derive(Clone, Copy, Debug)]
@@ -71,19 +70,19 @@ mod x86 {
         // SAFETY (for the whole function): the caller guarantees AVX; every row is 32 bytes
         // inside a node aligned to 64, so the aligned loads are in bounds and aligned.
         unsafe {
-            let scale = _mm256_set1_ps(ROBUST_FAR_SCALE);
             let mut enter = _mm256_set1_ps(ray.t_min);
             let mut exit = _mm256_set1_ps(limit);
             for a in 0..3 {
                 let o = _mm256_set1_ps(ray.origin[a]);
                 let inv = _mm256_set1_ps(ray.inv_dir[a]);
+                let inv_far = _mm256_set1_ps(ray.inv_far[a]);
                 // The rows from the direction's sign bit (as `NodeRay::near` and `far` hold
                 // them): indices the compiler sees are in bounds, so no check per row.
                 let down = (ray.negative_bits >> a & 1) as usize;
                 let near = _mm256_load_ps(node.bounds[2 * a + down].as_ptr());
                 let far = _mm256_load_ps(node.bounds[2 * a + 1 - down].as_ptr());
                 let t_near = _mm256_mul_ps(_mm256_sub_ps(near, o), inv);
-                let t_far = _mm256_mul_ps(_mm256_mul_ps(_mm256_sub_ps(far, o), inv), scale);
+                let t_far = _mm256_mul_ps(_mm256_sub_ps(far, o), inv_far);
                 // `max(a, b)` is `a > b ? a : b`, `b` when either is NaN: the scalar rule.
                 enter = _mm256_max_ps(t_near, enter);
                 exit = _mm256_min_ps(t_far, exit);
