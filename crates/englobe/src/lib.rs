@@ -23,11 +23,11 @@ pub mod geom;
 pub mod shapes;
 pub mod world;
 
-pub use accel::{Accel, AccelKind, AnyAccel, Counters, Hit, NoCount, TriangleBvh, WideBvh, WorkCounts};
+pub use accel::{Accel, AccelKind, AnyAccel, ClosestPoint, Counters, Hit, NoCount, TriangleBvh, WideBvh, WorkCounts};
 pub use geom::{Aabb, PrimHit, Ray};
 pub use glam::{Affine3A, Mat4, Vec2, Vec3};
 pub use shapes::{AaBox, Bounded, Instance, Intersect, Plane, Shape, Sphere, Triangle, TriangleMesh};
-pub use world::{BottomLevel, Object, World, WorldError, WorldHit};
+pub use world::{BottomLevel, Object, World, WorldError, WorldHit, WorldPoint};
 
 // The README's examples are compiled and run as doctests.
 #[cfg(doctest)]

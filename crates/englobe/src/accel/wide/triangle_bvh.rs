@@ -17,7 +17,7 @@ use super::triangles::{LANES, TriBlock, TriRay, UNUSED, intersect_block, is_stor
 use crate::accel::bvh::BinnedSah;
 use crate::accel::bvh::build::parallel::fill_indexed;
 use crate::accel::{Counters, Hit, LEAF_SIZE_BUCKETS, MAX_PRIMITIVES, StructureStats};
-use crate::shapes::TriangleMesh;
+use crate::shapes::{MeshError, TriangleMesh, check_arrays};
 use crate::{Aabb, Ray};
 
 /// How a [`TriangleBvh`] is built.
@@ -49,13 +49,21 @@ impl Default for TriangleBvhOptions {
 /// ```
 #[derive(Clone, Debug)]
 pub struct TriangleBvh {
-    nodes: Vec<WideNode>,
-    blocks: Vec<TriBlock>,
-    depth: u32,
-    bounds: Aabb,
+    pub(super) nodes: Vec<WideNode>,
+    pub(super) blocks: Vec<TriBlock>,
+    pub(super) depth: u32,
+    pub(super) bounds: Aabb,
     /// Triangles stored (zero-area ones are left out: they are never hit).
-    stored: usize,
-    isa: Isa,
+    pub(super) stored: usize,
+    pub(super) isa: Isa,
+}
+
+/// Triangle `i` of plain arrays whose indices were checked.
+pub(super) fn triangle_of<'a>(
+    vertices: &'a [[f32; 3]],
+    triangles: &'a [[u32; 3]],
+) -> impl Fn(u32) -> [Vec3; 3] + Sync + 'a {
+    move |i| triangles[i as usize].map(|v| Vec3::from_array(vertices[v as usize]))
 }
 
 /// Packs leaves into blocks of four triangles.
@@ -94,6 +102,24 @@ impl TriangleBvh {
     /// Builds the structure over a triangle soup (triangle `i` is `triangles[i]`).
     pub fn from_triangles(triangles: &[[Vec3; 3]]) -> Self {
         Self::build_with(triangles.len(), |i| triangles[i as usize], TriangleBvhOptions::default())
+    }
+
+    /// Builds the structure over plain arrays: vertex positions as `[x, y, z]` and triangles as
+    /// three vertex indices (triangle `i` is `triangles[i]`), read in place, never copied into a
+    /// mesh. An index past the vertices or a non-finite coordinate is an error, never a panic.
+    ///
+    /// ```
+    /// use englobe::{NoCount, Ray, TriangleBvh, Vec3};
+    ///
+    /// let vertices = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+    /// let bvh = TriangleBvh::from_arrays(&vertices, &[[0, 1, 2]])?;
+    /// assert!(bvh.any_hit(&Ray::new(Vec3::new(0.2, 0.2, 1.0), -Vec3::Z), &mut NoCount));
+    /// assert!(TriangleBvh::from_arrays(&vertices, &[[0, 1, 3]]).is_err());
+    /// # Ok::<(), englobe::shapes::MeshError>(())
+    /// ```
+    pub fn from_arrays(vertices: &[[f32; 3]], triangles: &[[u32; 3]]) -> Result<Self, MeshError> {
+        check_arrays(vertices, triangles)?;
+        Ok(Self::build_with(triangles.len(), triangle_of(vertices, triangles), TriangleBvhOptions::default()))
     }
 
     /// Builds the structure over `count` triangles, triangle `i` given by `triangle(i)`, at most
