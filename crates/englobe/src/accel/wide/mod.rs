@@ -22,6 +22,8 @@
 //!   [`TriangleBvh`].
 //! * [`point_query`]: the closest point of the triangles to a point; [`box_query`]: the
 //!   triangles overlapping a box.
+//! * [`refit`]: the boxes recomputed after the triangles moved, and the SAH cost that says when
+//!   to rebuild instead.
 //! * [`validate`]: the invariants of both, checked.
 
 pub mod box_query;
@@ -31,6 +33,7 @@ pub mod isa;
 pub mod kernels;
 pub mod node;
 pub mod point_query;
+pub mod refit;
 pub mod traverse;
 pub mod triangle_bvh;
 pub mod triangles;
@@ -38,6 +41,7 @@ pub mod validate;
 
 pub use isa::{Isa, IsaUnavailable};
 pub use point_query::ClosestPoint;
+pub use refit::{RefitError, RefitReport};
 pub use triangle_bvh::{TriangleBvh, TriangleBvhOptions};
 
 use convert::{ConvertOptions, LeafSink, convert};

@@ -55,6 +55,11 @@ pub struct TriangleBvh {
     pub(super) bounds: Aabb,
     /// Triangles stored (zero-area ones are left out: they are never hit).
     pub(super) stored: usize,
+    /// Triangles given to the build (stored or left out).
+    pub(super) count: usize,
+    pub(super) options: TriangleBvhOptions,
+    /// The SAH cost when built (see [`TriangleBvh::sah_cost`]).
+    pub(super) built_sah_cost: f32,
     pub(super) isa: Isa,
 }
 
@@ -137,14 +142,19 @@ impl TriangleBvh {
         let bvh = options.builder.build(&kept);
         let mut sink = Blocks { triangle: &triangle, ids: &ids, blocks: Vec::new(), scratch: Vec::new() };
         let layout = convert(&bvh, ConvertOptions { collapse: options.collapse }, &mut sink);
-        TriangleBvh {
+        let mut built = TriangleBvh {
             nodes: layout.nodes,
             blocks: sink.blocks,
             depth: layout.depth,
             bounds: bvh.bounds(),
             stored: ids.len(),
+            count,
+            options,
+            built_sah_cost: 0.0,
             isa: Isa::best(),
-        }
+        };
+        built.built_sah_cost = built.sah_cost();
+        built
     }
 
     /// The instruction set queries run with.
