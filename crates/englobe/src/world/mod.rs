@@ -27,6 +27,7 @@
 
 use glam::Vec3;
 
+mod batch;
 mod bottom;
 mod object;
 mod proximity;

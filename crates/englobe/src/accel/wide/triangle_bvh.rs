@@ -16,7 +16,8 @@ use super::traverse::Leaves;
 use super::triangles::{LANES, TriBlock, TriRay, UNUSED, intersect_block, is_storable};
 use crate::accel::bvh::BinnedSah;
 use crate::accel::bvh::build::parallel::fill_indexed;
-use crate::accel::{Counters, Hit, LEAF_SIZE_BUCKETS, MAX_PRIMITIVES, StructureStats};
+use crate::accel::interface::batch::run_batch;
+use crate::accel::{BatchSizeMismatch, Counters, Hit, LEAF_SIZE_BUCKETS, MAX_PRIMITIVES, NoCount, StructureStats};
 use crate::shapes::{MeshError, TriangleMesh, check_arrays};
 use crate::{Aabb, Ray};
 
@@ -213,6 +214,18 @@ impl TriangleBvh {
         }
         let mut leaves = TriangleLeaves { blocks: &self.blocks, source: ray, ray: None, best: None, t_max: ray.t_max };
         dispatch::any(self.isa, &self.nodes, self.depth, &NodeRay::new(ray), reach(ray.t_max), &mut leaves, counters)
+    }
+
+    /// The closest hit of every ray, `hits[i]` for `rays[i]`: [`TriangleBvh::closest_hit`] ray
+    /// after ray, on several threads for large batches (see [`crate::accel::interface::batch`]).
+    /// The two slices must be as long.
+    pub fn closest_hits(&self, rays: &[Ray], hits: &mut [Option<Hit>]) -> Result<(), BatchSizeMismatch> {
+        run_batch(rays, hits, |r| self.closest_hit(r, &mut NoCount))
+    }
+
+    /// Whether each ray hits anything, `mask[i]` for `rays[i]` (see [`TriangleBvh::closest_hits`]).
+    pub fn any_hits(&self, rays: &[Ray], mask: &mut [bool]) -> Result<(), BatchSizeMismatch> {
+        run_batch(rays, mask, |r| self.any_hit(r, &mut NoCount))
     }
 
     /// Size and shape: wide nodes, leaves, depth, stored triangles and bytes. The leaf sizes count
