@@ -23,7 +23,10 @@ pub mod geom;
 pub mod shapes;
 pub mod world;
 
-pub use accel::{Accel, AccelKind, AnyAccel, ClosestPoint, Counters, Hit, NoCount, TriangleBvh, WideBvh, WorkCounts};
+pub use accel::{
+    Accel, AccelKind, AnyAccel, ClosestPoint, Counters, Hit, HitFilter, NoCount, NoFilter, TriangleBvh, WideBvh,
+    WorkCounts,
+};
 pub use geom::{Aabb, PrimHit, Ray};
 pub use glam::{Affine3A, Mat4, Vec2, Vec3};
 pub use shapes::{AaBox, Bounded, Instance, Intersect, Plane, Shape, Sphere, Triangle, TriangleMesh};

@@ -28,8 +28,8 @@ pub mod wide;
 pub use bvh::{BinnedSah, Bvh, Ploc, SweepSah};
 pub use grid::{Grid, GridParams};
 pub use interface::{
-    Accel, BatchSizeMismatch, ClipFn, Counters, Hit, HitRecord, InvalidStructure, LEAF_SIZE_BUCKETS, MAX_PRIMITIVES,
-    NoCount, PARALLEL_BATCH, StructureStats, Validate, WorkCounts,
+    Accel, BatchSizeMismatch, ClipFn, Counters, Hit, HitFilter, HitRecord, InvalidStructure, LEAF_SIZE_BUCKETS,
+    MAX_PRIMITIVES, NoCount, NoFilter, PARALLEL_BATCH, StructureStats, Validate, WorkCounts,
 };
 pub use kdtree::{KdTree, KdTreeParams};
 pub use reference::{BruteForce, CandidateListBvh, LowerBound, SeedPairing};
