@@ -67,8 +67,8 @@ where
     Ok(())
 }
 
-/// [`check_mesh`] for plain arrays: what [`TriangleMesh::from_arrays`] and
-/// [`crate::TriangleBvh::from_arrays`] accept.
+/// Checks plain arrays as [`TriangleMesh::new`] checks a mesh: what [`TriangleMesh::from_arrays`]
+/// and [`crate::TriangleBvh::from_arrays`] accept.
 pub fn check_arrays(vertices: &[[f32; 3]], triangles: &[[u32; 3]]) -> Result<(), MeshError> {
     check_mesh(vertices, triangles)
 }
