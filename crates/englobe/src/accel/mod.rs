@@ -28,10 +28,10 @@ pub mod wide;
 pub use bvh::{BinnedSah, Bvh, Ploc, SweepSah};
 pub use grid::{Grid, GridParams};
 pub use interface::{
-    Accel, ClipFn, Counters, Hit, HitRecord, InvalidStructure, LEAF_SIZE_BUCKETS, MAX_PRIMITIVES, NoCount,
-    StructureStats, Validate, WorkCounts,
+    Accel, BatchSizeMismatch, ClipFn, Counters, Hit, HitFilter, HitRecord, InvalidStructure, LEAF_SIZE_BUCKETS,
+    MAX_PRIMITIVES, NoCount, NoFilter, PARALLEL_BATCH, StructureStats, Validate, WorkCounts,
 };
 pub use kdtree::{KdTree, KdTreeParams};
 pub use reference::{BruteForce, CandidateListBvh, LowerBound, SeedPairing};
 pub use select::{AccelKind, AnyAccel, UnknownAccel};
-pub use wide::{Isa, TriangleBvh, WideBvh};
+pub use wide::{ClosestPoint, Isa, TriangleBvh, WideBvh};

@@ -44,6 +44,35 @@ pub enum MeshError {
     TooLarge(usize),
 }
 
+/// Checks vertex positions and triangles: sizes that fit 32-bit indices, finite coordinates,
+/// indices inside the vertex array.
+fn check_mesh<P: Copy>(positions: &[P], triangles: &[[u32; 3]]) -> Result<(), MeshError>
+where
+    Vec3: From<P>,
+{
+    for n in [positions.len(), triangles.len()] {
+        if n > u32::MAX as usize {
+            return Err(MeshError::TooLarge(n));
+        }
+    }
+    if let Some((vertex, position)) = positions.iter().map(|&p| Vec3::from(p)).enumerate().find(|(_, p)| !p.is_finite())
+    {
+        return Err(MeshError::NonFiniteVertex { vertex, position });
+    }
+    for (triangle, t) in triangles.iter().enumerate() {
+        if let Some(&index) = t.iter().find(|&&i| i as usize >= positions.len()) {
+            return Err(MeshError::IndexOutOfRange { triangle, index, vertices: positions.len() });
+        }
+    }
+    Ok(())
+}
+
+/// Checks plain arrays as [`TriangleMesh::new`] checks a mesh: what [`TriangleMesh::from_arrays`]
+/// and [`crate::TriangleBvh::from_arrays`] accept.
+pub fn check_arrays(vertices: &[[f32; 3]], triangles: &[[u32; 3]]) -> Result<(), MeshError> {
+    check_mesh(vertices, triangles)
+}
+
 /// An indexed triangle mesh with optional per-vertex normals (for smooth shading) and texture
 /// coordinates. Construction checks every index and coordinate, so queries never can fail.
 #[derive(Clone, Debug, PartialEq)]
@@ -57,20 +86,32 @@ pub struct TriangleMesh {
 impl TriangleMesh {
     /// A mesh from vertex positions and triangles (vertex indices, counter-clockwise).
     pub fn new(positions: Vec<Vec3>, triangles: Vec<[u32; 3]>) -> Result<Self, MeshError> {
-        for n in [positions.len(), triangles.len()] {
-            if n > u32::MAX as usize {
-                return Err(MeshError::TooLarge(n));
-            }
-        }
-        if let Some((vertex, &position)) = positions.iter().enumerate().find(|(_, p)| !p.is_finite()) {
-            return Err(MeshError::NonFiniteVertex { vertex, position });
-        }
-        for (triangle, t) in triangles.iter().enumerate() {
-            if let Some(&index) = t.iter().find(|&&i| i as usize >= positions.len()) {
-                return Err(MeshError::IndexOutOfRange { triangle, index, vertices: positions.len() });
-            }
-        }
+        check_mesh(&positions, &triangles)?;
         Ok(TriangleMesh { positions, triangles, normals: None, uvs: None })
+    }
+
+    /// A mesh from plain arrays: vertex positions as `[x, y, z]` and triangles as three vertex
+    /// indices each, checked as [`TriangleMesh::new`] checks them (an index past the vertices or
+    /// a non-finite coordinate is an error, never a panic).
+    ///
+    /// ```
+    /// use englobe::TriangleMesh;
+    /// use englobe::shapes::MeshError;
+    ///
+    /// let mesh = TriangleMesh::from_arrays(&[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]], &[[0, 1, 2]])?;
+    /// assert_eq!(mesh.len(), 1);
+    /// let bad = TriangleMesh::from_arrays(&[[0.0, 0.0, 0.0]], &[[0, 1, 2]]);
+    /// assert_eq!(bad, Err(MeshError::IndexOutOfRange { triangle: 0, index: 1, vertices: 1 }));
+    /// # Ok::<(), MeshError>(())
+    /// ```
+    pub fn from_arrays(vertices: &[[f32; 3]], triangles: &[[u32; 3]]) -> Result<Self, MeshError> {
+        check_arrays(vertices, triangles)?;
+        Ok(TriangleMesh {
+            positions: vertices.iter().map(|&p| Vec3::from_array(p)).collect(),
+            triangles: triangles.to_vec(),
+            normals: None,
+            uvs: None,
+        })
     }
 
     /// Adds per-vertex normals (one per vertex; normalised when used).

@@ -4,20 +4,24 @@
 
 mod aabox;
 mod clip;
+mod closest_point;
 mod instance;
 mod interface;
 mod mesh;
 mod plane;
 mod sphere;
 mod triangle;
+mod triangle_box;
 
 pub use aabox::AaBox;
 pub use clip::clip_triangle;
+pub use closest_point::{closest_point_on_triangle, distance_squared, distance_squared_to_box};
 pub use instance::{Instance, InstanceError, transform_box};
-pub use mesh::{MeshError, TriangleMesh};
+pub use mesh::{MeshError, TriangleMesh, check_arrays};
 pub use plane::Plane;
 pub use sphere::Sphere;
 pub use triangle::{Triangle, WatertightRay, intersect_triangle, is_degenerate};
+pub use triangle_box::triangle_overlaps_box;
 
 pub use interface::{Bounded, Intersect};
 

@@ -15,7 +15,7 @@ use std::collections::HashMap;
 use std::sync::Arc;
 
 use super::Object;
-use crate::accel::{Accel, AccelKind, AnyAccel, Counters, Hit, StructureStats, TriangleBvh};
+use crate::accel::{Accel, AccelKind, AnyAccel, Counters, Hit, HitFilter, NoFilter, StructureStats, TriangleBvh};
 use crate::shapes::{TriangleMesh, WatertightRay, clip_triangle};
 use crate::{Aabb, Ray};
 
@@ -73,30 +73,54 @@ impl BottomLevel {
     /// The closest triangle hit by `ray`, given in the mesh's space: `prim` is the triangle.
     #[inline]
     pub fn closest_hit<C: Counters>(&self, ray: &Ray, counters: &mut C) -> Option<Hit> {
-        match &self.accel {
-            BottomAccel::Triangles(t) => t.closest_hit(ray, counters),
-            BottomAccel::Generic(accel) => {
-                // The mesh's box first: brute force has no root box of its own to skip the mesh with.
-                counters.box_tests(1);
-                accel.bounds().intersect(ray)?;
-                let w = WatertightRay::new(ray);
-                accel.closest_hit(ray, counters, |tri, r| self.mesh.intersect_with(tri, r, &w))
-            }
-        }
+        self.closest_hit_filtered(ray, counters, NoFilter)
     }
 
     /// Whether `ray`, given in the mesh's space, hits a triangle within its interval.
     #[inline]
     pub fn any_hit<C: Counters>(&self, ray: &Ray, counters: &mut C) -> bool {
+        self.any_hit_filtered(ray, counters, NoFilter)
+    }
+
+    /// [`BottomLevel::closest_hit`] among the hits `filter` accepts.
+    #[inline]
+    pub fn closest_hit_filtered<C: Counters, F: HitFilter<Hit>>(
+        &self,
+        ray: &Ray,
+        counters: &mut C,
+        mut filter: F,
+    ) -> Option<Hit> {
         match &self.accel {
-            BottomAccel::Triangles(t) => t.any_hit(ray, counters),
+            BottomAccel::Triangles(t) => t.closest_hit_filtered(ray, counters, filter),
+            BottomAccel::Generic(accel) => {
+                // The mesh's box first: brute force has no root box of its own to skip the mesh with.
+                counters.box_tests(1);
+                accel.bounds().intersect(ray)?;
+                let w = WatertightRay::new(ray);
+                accel.closest_hit(ray, counters, |tri, r| {
+                    let h = self.mesh.intersect_with(tri, r, &w)?;
+                    (F::ACCEPTS_ALL || filter.accept(&Hit { t: h.t, prim: tri, u: h.u, v: h.v })).then_some(h)
+                })
+            }
+        }
+    }
+
+    /// [`BottomLevel::any_hit`] counting only the hits `filter` accepts.
+    #[inline]
+    pub fn any_hit_filtered<C: Counters, F: HitFilter<Hit>>(&self, ray: &Ray, counters: &mut C, mut filter: F) -> bool {
+        match &self.accel {
+            BottomAccel::Triangles(t) => t.any_hit_filtered(ray, counters, filter),
             BottomAccel::Generic(accel) => {
                 counters.box_tests(1);
                 if accel.bounds().intersect(ray).is_none() {
                     return false;
                 }
                 let w = WatertightRay::new(ray);
-                accel.any_hit(ray, counters, |tri, r| self.mesh.intersect_with(tri, r, &w).is_some())
+                accel.any_hit(ray, counters, |tri, r| {
+                    self.mesh
+                        .intersect_with(tri, r, &w)
+                        .is_some_and(|h| F::ACCEPTS_ALL || filter.accept(&Hit { t: h.t, prim: tri, u: h.u, v: h.v }))
+                })
             }
         }
     }

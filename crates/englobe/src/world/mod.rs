@@ -27,8 +27,10 @@
 
 use glam::Vec3;
 
+mod batch;
 mod bottom;
 mod object;
+mod proximity;
 mod query;
 
 use crate::PrimHit;
@@ -69,6 +71,19 @@ pub struct WorldHit {
     pub u: f32,
     /// Second surface coordinate.
     pub v: f32,
+}
+
+/// The closest point of a world's meshes to a query point.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WorldPoint {
+    /// The mesh object it lies on.
+    pub object: u32,
+    /// Its triangle within that mesh.
+    pub prim: u32,
+    /// The point.
+    pub point: Vec3,
+    /// Its distance to the query point.
+    pub distance: f32,
 }
 
 /// Objects plus acceleration structures over their bounded primitives.

@@ -12,7 +12,7 @@ use super::bottom::ClosestInstance;
 use super::{Object, World, WorldHit};
 use crate::PrimHit;
 use crate::Ray;
-use crate::accel::{Accel, Counters, Hit};
+use crate::accel::{Accel, Counters, Hit, HitFilter, NoFilter};
 use crate::shapes::{Instance, Intersect, WatertightRay};
 
 /// Whether `hit` beats `best` under the rule of the module.
@@ -35,28 +35,79 @@ impl World {
         self.accel_prims.as_ref().map_or(i, |p| p[i as usize])
     }
 
-    /// The closest hit of `ray` (in world space) with the mesh of `inst`, object `object`: `prim`
-    /// of the answer is the triangle, `t` is the world ray's parameter.
+    /// The closest hit of `ray` (in world space) with the mesh of `inst`, object `object`, among
+    /// those `filter` accepts: `prim` of the answer is the triangle, `t` is the world ray's
+    /// parameter.
     #[inline]
-    fn instance_closest_hit<C: Counters>(&self, object: u32, inst: &Instance, ray: &Ray, c: &mut C) -> Option<Hit> {
-        self.bottom[self.object_bottom[object as usize] as usize].closest_hit(&inst.local_ray(ray), c)
+    fn instance_closest_hit<C: Counters, F: HitFilter<WorldHit>>(
+        &self,
+        object: u32,
+        inst: &Instance,
+        ray: &Ray,
+        c: &mut C,
+        filter: &mut F,
+    ) -> Option<Hit> {
+        let bottom = &self.bottom[self.object_bottom[object as usize] as usize];
+        bottom.closest_hit_filtered(&inst.local_ray(ray), c, InObject { object, filter })
     }
 
-    /// Whether `ray` hits the mesh of `inst` within its interval.
+    /// Whether `ray` hits the mesh of `inst` within its interval, where `filter` accepts.
     #[inline]
-    fn instance_any_hit<C: Counters>(&self, object: u32, inst: &Instance, ray: &Ray, c: &mut C) -> bool {
-        self.bottom[self.object_bottom[object as usize] as usize].any_hit(&inst.local_ray(ray), c)
+    fn instance_any_hit<C: Counters, F: HitFilter<WorldHit>>(
+        &self,
+        object: u32,
+        inst: &Instance,
+        ray: &Ray,
+        c: &mut C,
+        filter: &mut F,
+    ) -> bool {
+        let bottom = &self.bottom[self.object_bottom[object as usize] as usize];
+        bottom.any_hit_filtered(&inst.local_ray(ray), c, InObject { object, filter })
     }
 
     /// The closest hit, or `None`. Ties at equal `t` go to the lower object (then primitive) index.
+    #[inline]
     pub fn closest_hit<C: Counters>(&self, ray: &Ray, counters: &mut C) -> Option<WorldHit> {
+        self.closest_hit_filtered(ray, counters, NoFilter)
+    }
+
+    /// Whether anything is hit within the ray's interval (shadow rays).
+    #[inline]
+    pub fn any_hit<C: Counters>(&self, ray: &Ray, counters: &mut C) -> bool {
+        self.any_hit_filtered(ray, counters, NoFilter)
+    }
+
+    /// [`World::closest_hit`] among the hits `filter` accepts (see
+    /// [`crate::accel::interface::filter`]): a hit the filter rejects is as if its primitive
+    /// were not there, for this query.
+    ///
+    /// ```
+    /// use englobe::{AccelKind, NoCount, Ray, Sphere, Vec3, World, WorldHit};
+    ///
+    /// let spheres = vec![Sphere::new(Vec3::Z * 3.0, 1.0).into(), Sphere::new(Vec3::Z * 8.0, 1.0).into()];
+    /// let world = World::build(spheres, AccelKind::BvhWide)?;
+    /// let ray = Ray::new(Vec3::ZERO, Vec3::Z);
+    /// let hit = world.closest_hit_filtered(&ray, &mut NoCount, |h: &WorldHit| h.object != 0).expect("the far sphere");
+    /// assert_eq!((hit.object, hit.t), (1, 7.0));
+    /// # Ok::<(), englobe::WorldError>(())
+    /// ```
+    pub fn closest_hit_filtered<C: Counters, F: HitFilter<WorldHit>>(
+        &self,
+        ray: &Ray,
+        counters: &mut C,
+        mut filter: F,
+    ) -> Option<WorldHit> {
         if !ray.is_valid() {
             return None;
         }
-        let mut best = self.triangles.as_ref().and_then(|t| t.closest_hit(ray, counters)).map(|h| {
-            let (object, prim) = self.locate(h.prim);
-            WorldHit { t: h.t, object, prim, u: h.u, v: h.v }
-        });
+        let mut best = self
+            .triangles
+            .as_ref()
+            .and_then(|t| t.closest_hit_filtered(ray, counters, Located { world: self, filter: &mut filter }))
+            .map(|h| {
+                let (object, prim) = self.locate(h.prim);
+                WorldHit { t: h.t, object, prim, u: h.u, v: h.v }
+            });
         // Work inside instances is counted apart (the structure holds `counters` during its query)
         // and merged afterwards.
         let mut nested = C::default();
@@ -67,17 +118,19 @@ impl World {
         let found = self.accel_in_use().then(|| {
             self.accel.closest_hit(&bounded, counters, |i, r| {
                 let (object, local) = self.locate(self.accel_prim(i));
-                match &self.objects[object as usize] {
-                    Object::Shape(s) => s.intersect(r),
+                let h = match &self.objects[object as usize] {
+                    Object::Shape(s) => s.intersect(r)?,
                     Object::Mesh(m) => {
-                        m.intersect_with(local, r, watertight.get_or_insert_with(|| WatertightRay::new(ray)))
+                        m.intersect_with(local, r, watertight.get_or_insert_with(|| WatertightRay::new(ray)))?
                     }
                     Object::Instance(inst) => {
-                        let hit = self.instance_closest_hit(object, inst, r, &mut nested)?;
+                        let hit = self.instance_closest_hit(object, inst, r, &mut nested, &mut filter)?;
                         instance_hits.offer(i, &hit);
-                        Some(PrimHit { t: hit.t, u: hit.u, v: hit.v })
+                        return Some(PrimHit { t: hit.t, u: hit.u, v: hit.v });
                     }
-                }
+                };
+                let candidate = WorldHit { t: h.t, object, prim: local, u: h.u, v: h.v };
+                (F::ACCEPTS_ALL || filter.accept(&candidate)).then_some(h)
             })
         });
         counters.merge(&nested);
@@ -88,7 +141,7 @@ impl World {
                     // Only a structure that breaks the tie rule of `HitRecord::offer` gets here:
                     // ask the instance again, up to the hit.
                     let r = ray.with_range(ray.t_min, h.t);
-                    self.instance_closest_hit(object, inst, &r, &mut C::default()).map_or(0, |x| x.prim)
+                    self.instance_closest_hit(object, inst, &r, &mut C::default(), &mut filter).map_or(0, |x| x.prim)
                 }),
                 _ => local,
             };
@@ -103,7 +156,7 @@ impl World {
             let Object::Shape(shape) = &self.objects[object as usize] else { continue };
             if let Some(h) = shape.intersect(&bounded) {
                 let hit = WorldHit { t: h.t, object, prim: 0, u: h.u, v: h.v };
-                if beats(&hit, best.as_ref()) {
+                if beats(&hit, best.as_ref()) && (F::ACCEPTS_ALL || filter.accept(&hit)) {
                     bounded.t_max = h.t;
                     best = Some(hit);
                 }
@@ -112,19 +165,31 @@ impl World {
         best
     }
 
-    /// Whether anything is hit within the ray's interval (shadow rays).
-    pub fn any_hit<C: Counters>(&self, ray: &Ray, counters: &mut C) -> bool {
+    /// [`World::any_hit`] counting only the hits `filter` accepts.
+    pub fn any_hit_filtered<C: Counters, F: HitFilter<WorldHit>>(
+        &self,
+        ray: &Ray,
+        counters: &mut C,
+        mut filter: F,
+    ) -> bool {
         if !ray.is_valid() {
             return false;
         }
         let unbounded_hit = self.unbounded.iter().any(|&object| {
             counters.exact_test();
             match &self.objects[object as usize] {
-                Object::Shape(s) => s.intersect(ray).is_some(),
+                Object::Shape(s) => s.intersect(ray).is_some_and(|h| {
+                    F::ACCEPTS_ALL || filter.accept(&WorldHit { t: h.t, object, prim: 0, u: h.u, v: h.v })
+                }),
                 Object::Mesh(_) | Object::Instance(_) => false,
             }
         });
-        if unbounded_hit || self.triangles.as_ref().is_some_and(|t| t.any_hit(ray, counters)) {
+        if unbounded_hit
+            || self
+                .triangles
+                .as_ref()
+                .is_some_and(|t| t.any_hit_filtered(ray, counters, Located { world: self, filter: &mut filter }))
+        {
             return true;
         }
         if !self.accel_in_use() {
@@ -134,16 +199,51 @@ impl World {
         let mut watertight = None;
         let hit = self.accel.any_hit(ray, counters, |i, r| {
             let (object, local) = self.locate(self.accel_prim(i));
-            match &self.objects[object as usize] {
-                Object::Shape(s) => s.intersect(r).is_some(),
+            let h = match &self.objects[object as usize] {
+                Object::Shape(s) => s.intersect(r),
                 Object::Mesh(m) => {
-                    m.intersect_with(local, r, watertight.get_or_insert_with(|| WatertightRay::new(ray))).is_some()
+                    m.intersect_with(local, r, watertight.get_or_insert_with(|| WatertightRay::new(ray)))
                 }
-                Object::Instance(inst) => self.instance_any_hit(object, inst, r, &mut nested),
-            }
+                Object::Instance(inst) => return self.instance_any_hit(object, inst, r, &mut nested, &mut filter),
+            };
+            h.is_some_and(|h| {
+                F::ACCEPTS_ALL || filter.accept(&WorldHit { t: h.t, object, prim: local, u: h.u, v: h.v })
+            })
         });
         counters.merge(&nested);
         hit
+    }
+}
+
+/// A world filter seen by the plain meshes' [`crate::TriangleBvh`]: its triangle numbers are the
+/// world's primitive numbers, turned into an object and its triangle.
+struct Located<'a, F> {
+    world: &'a World,
+    filter: &'a mut F,
+}
+
+impl<F: HitFilter<WorldHit>> HitFilter<Hit> for Located<'_, F> {
+    const ACCEPTS_ALL: bool = F::ACCEPTS_ALL;
+
+    #[inline(always)]
+    fn accept(&mut self, h: &Hit) -> bool {
+        let (object, prim) = self.world.locate(h.prim);
+        self.filter.accept(&WorldHit { t: h.t, object, prim, u: h.u, v: h.v })
+    }
+}
+
+/// A world filter seen by an instance's bottom level: its triangles are the object's.
+struct InObject<'a, F> {
+    object: u32,
+    filter: &'a mut F,
+}
+
+impl<F: HitFilter<WorldHit>> HitFilter<Hit> for InObject<'_, F> {
+    const ACCEPTS_ALL: bool = F::ACCEPTS_ALL;
+
+    #[inline(always)]
+    fn accept(&mut self, h: &Hit) -> bool {
+        self.filter.accept(&WorldHit { t: h.t, object: self.object, prim: h.prim, u: h.u, v: h.v })
     }
 }
 

@@ -20,19 +20,28 @@
 //! * [`traverse`]: the single-ray traversal, generic over kernels and leaves.
 //! * [`triangles`]: blocks of four triangles and their SIMD watertight test; [`triangle_bvh`]:
 //!   [`TriangleBvh`].
+//! * [`point_query`]: the closest point of the triangles to a point; [`box_query`]: the
+//!   triangles overlapping a box.
+//! * [`refit`]: the boxes recomputed after the triangles moved, and the SAH cost that says when
+//!   to rebuild instead.
 //! * [`validate`]: the invariants of both, checked.
 
+pub mod box_query;
 pub mod convert;
 pub mod dispatch;
 pub mod isa;
 pub mod kernels;
 pub mod node;
+pub mod point_query;
+pub mod refit;
 pub mod traverse;
 pub mod triangle_bvh;
 pub mod triangles;
 pub mod validate;
 
 pub use isa::{Isa, IsaUnavailable};
+pub use point_query::ClosestPoint;
+pub use refit::{RefitError, RefitReport};
 pub use triangle_bvh::{TriangleBvh, TriangleBvhOptions};
 
 use convert::{ConvertOptions, LeafSink, convert};

@@ -16,8 +16,11 @@ use super::traverse::Leaves;
 use super::triangles::{LANES, TriBlock, TriRay, UNUSED, intersect_block, is_storable};
 use crate::accel::bvh::BinnedSah;
 use crate::accel::bvh::build::parallel::fill_indexed;
-use crate::accel::{Counters, Hit, LEAF_SIZE_BUCKETS, MAX_PRIMITIVES, StructureStats};
-use crate::shapes::TriangleMesh;
+use crate::accel::interface::batch::run_batch;
+use crate::accel::{
+    BatchSizeMismatch, Counters, Hit, HitFilter, LEAF_SIZE_BUCKETS, MAX_PRIMITIVES, NoCount, NoFilter, StructureStats,
+};
+use crate::shapes::{MeshError, TriangleMesh, check_arrays};
 use crate::{Aabb, Ray};
 
 /// How a [`TriangleBvh`] is built.
@@ -49,13 +52,26 @@ impl Default for TriangleBvhOptions {
 /// ```
 #[derive(Clone, Debug)]
 pub struct TriangleBvh {
-    nodes: Vec<WideNode>,
-    blocks: Vec<TriBlock>,
-    depth: u32,
-    bounds: Aabb,
+    pub(super) nodes: Vec<WideNode>,
+    pub(super) blocks: Vec<TriBlock>,
+    pub(super) depth: u32,
+    pub(super) bounds: Aabb,
     /// Triangles stored (zero-area ones are left out: they are never hit).
-    stored: usize,
-    isa: Isa,
+    pub(super) stored: usize,
+    /// Triangles given to the build (stored or left out).
+    pub(super) count: usize,
+    pub(super) options: TriangleBvhOptions,
+    /// The SAH cost when built (see [`TriangleBvh::sah_cost`]).
+    pub(super) built_sah_cost: f32,
+    pub(super) isa: Isa,
+}
+
+/// Triangle `i` of plain arrays whose indices were checked.
+pub(super) fn triangle_of<'a>(
+    vertices: &'a [[f32; 3]],
+    triangles: &'a [[u32; 3]],
+) -> impl Fn(u32) -> [Vec3; 3] + Sync + 'a {
+    move |i| triangles[i as usize].map(|v| Vec3::from_array(vertices[v as usize]))
 }
 
 /// Packs leaves into blocks of four triangles.
@@ -96,6 +112,24 @@ impl TriangleBvh {
         Self::build_with(triangles.len(), |i| triangles[i as usize], TriangleBvhOptions::default())
     }
 
+    /// Builds the structure over plain arrays: vertex positions as `[x, y, z]` and triangles as
+    /// three vertex indices (triangle `i` is `triangles[i]`), read in place, never copied into a
+    /// mesh. An index past the vertices or a non-finite coordinate is an error, never a panic.
+    ///
+    /// ```
+    /// use englobe::{NoCount, Ray, TriangleBvh, Vec3};
+    ///
+    /// let vertices = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+    /// let bvh = TriangleBvh::from_arrays(&vertices, &[[0, 1, 2]])?;
+    /// assert!(bvh.any_hit(&Ray::new(Vec3::new(0.2, 0.2, 1.0), -Vec3::Z), &mut NoCount));
+    /// assert!(TriangleBvh::from_arrays(&vertices, &[[0, 1, 3]]).is_err());
+    /// # Ok::<(), englobe::shapes::MeshError>(())
+    /// ```
+    pub fn from_arrays(vertices: &[[f32; 3]], triangles: &[[u32; 3]]) -> Result<Self, MeshError> {
+        check_arrays(vertices, triangles)?;
+        Ok(Self::build_with(triangles.len(), triangle_of(vertices, triangles), TriangleBvhOptions::default()))
+    }
+
     /// Builds the structure over `count` triangles, triangle `i` given by `triangle(i)`, at most
     /// [`MAX_PRIMITIVES`] of them. Zero-area triangles are left out (they are never hit), and so
     /// are triangles with non-finite coordinates.
@@ -111,14 +145,19 @@ impl TriangleBvh {
         let bvh = options.builder.build(&kept);
         let mut sink = Blocks { triangle: &triangle, ids: &ids, blocks: Vec::new(), scratch: Vec::new() };
         let layout = convert(&bvh, ConvertOptions { collapse: options.collapse }, &mut sink);
-        TriangleBvh {
+        let mut built = TriangleBvh {
             nodes: layout.nodes,
             blocks: sink.blocks,
             depth: layout.depth,
             bounds: bvh.bounds(),
             stored: ids.len(),
+            count,
+            options,
+            built_sah_cost: 0.0,
             isa: Isa::best(),
-        }
+        };
+        built.built_sah_cost = built.sah_cost();
+        built
     }
 
     /// The instruction set queries run with.
@@ -161,22 +200,64 @@ impl TriangleBvh {
     /// the same `t`, the lower index wins.
     #[inline]
     pub fn closest_hit<C: Counters>(&self, ray: &Ray, counters: &mut C) -> Option<Hit> {
-        if !ray.is_valid() || self.nodes.is_empty() {
-            return None;
-        }
-        let mut leaves = TriangleLeaves { blocks: &self.blocks, source: ray, ray: None, best: None, t_max: ray.t_max };
-        dispatch::closest(self.isa, &self.nodes, self.depth, &NodeRay::new(ray), &mut leaves, counters);
-        leaves.best
+        self.closest_hit_filtered(ray, counters, NoFilter)
     }
 
     /// Whether any triangle is hit within the ray's interval (shadow rays).
     #[inline]
     pub fn any_hit<C: Counters>(&self, ray: &Ray, counters: &mut C) -> bool {
+        self.any_hit_filtered(ray, counters, NoFilter)
+    }
+
+    /// [`TriangleBvh::closest_hit`] among the hits `filter` accepts (see
+    /// [`crate::accel::interface::filter`]).
+    ///
+    /// ```
+    /// use englobe::{Hit, NoCount, Ray, TriangleBvh, Vec3};
+    ///
+    /// let near = [Vec3::ZERO, Vec3::X, Vec3::Y];
+    /// let bvh = TriangleBvh::from_triangles(&[near, near.map(|v| v - Vec3::Z)]);
+    /// let ray = Ray::new(Vec3::new(0.2, 0.2, 1.0), -Vec3::Z);
+    /// let hit = bvh.closest_hit_filtered(&ray, &mut NoCount, |h: &Hit| h.prim != 0).expect("the far one");
+    /// assert_eq!((hit.prim, hit.t), (1, 2.0));
+    /// ```
+    #[inline]
+    pub fn closest_hit_filtered<C: Counters, F: HitFilter<Hit>>(
+        &self,
+        ray: &Ray,
+        counters: &mut C,
+        filter: F,
+    ) -> Option<Hit> {
+        if !ray.is_valid() || self.nodes.is_empty() {
+            return None;
+        }
+        let mut leaves =
+            TriangleLeaves { blocks: &self.blocks, source: ray, ray: None, best: None, t_max: ray.t_max, filter };
+        dispatch::closest(self.isa, &self.nodes, self.depth, &NodeRay::new(ray), &mut leaves, counters);
+        leaves.best
+    }
+
+    /// [`TriangleBvh::any_hit`] counting only the hits `filter` accepts.
+    #[inline]
+    pub fn any_hit_filtered<C: Counters, F: HitFilter<Hit>>(&self, ray: &Ray, counters: &mut C, filter: F) -> bool {
         if !ray.is_valid() || self.nodes.is_empty() {
             return false;
         }
-        let mut leaves = TriangleLeaves { blocks: &self.blocks, source: ray, ray: None, best: None, t_max: ray.t_max };
+        let mut leaves =
+            TriangleLeaves { blocks: &self.blocks, source: ray, ray: None, best: None, t_max: ray.t_max, filter };
         dispatch::any(self.isa, &self.nodes, self.depth, &NodeRay::new(ray), reach(ray.t_max), &mut leaves, counters)
+    }
+
+    /// The closest hit of every ray, `hits[i]` for `rays[i]`: [`TriangleBvh::closest_hit`] ray
+    /// after ray, on several threads for large batches (see [`crate::accel::interface::batch`]).
+    /// The two slices must be as long.
+    pub fn closest_hits(&self, rays: &[Ray], hits: &mut [Option<Hit>]) -> Result<(), BatchSizeMismatch> {
+        run_batch(rays, hits, |r| self.closest_hit(r, &mut NoCount))
+    }
+
+    /// Whether each ray hits anything, `mask[i]` for `rays[i]` (see [`TriangleBvh::closest_hits`]).
+    pub fn any_hits(&self, rays: &[Ray], mask: &mut [bool]) -> Result<(), BatchSizeMismatch> {
+        run_batch(rays, mask, |r| self.any_hit(r, &mut NoCount))
     }
 
     /// Size and shape: wide nodes, leaves, depth, stored triangles and bytes. The leaf sizes count
@@ -210,8 +291,8 @@ impl TriangleBvh {
     }
 }
 
-/// A query's view of the triangle blocks, and its closest hit so far.
-struct TriangleLeaves<'a> {
+/// A query's view of the triangle blocks, its closest hit so far, and the caller's filter.
+struct TriangleLeaves<'a, F> {
     blocks: &'a [TriBlock],
     source: &'a Ray,
     /// The triangle test's constants, prepared at the first leaf: a ray that reaches none (one
@@ -219,23 +300,25 @@ struct TriangleLeaves<'a> {
     ray: Option<TriRay>,
     best: Option<Hit>,
     t_max: f32,
+    filter: F,
 }
 
 /// Keeps the hit on triangle `prim` in `best` if it is closer, or as close with a lower index
-/// (the rule of [`crate::accel::HitRecord::offer`]), and shrinks `t_max` to it.
+/// (the rule of [`crate::accel::HitRecord::offer`]), and the filter accepts it; shrinks `t_max`
+/// to it.
 #[inline(always)]
-fn offer(best: &mut Option<Hit>, t_max: &mut f32, prim: u32, t: f32, u: f32, v: f32) {
+fn offer<F: HitFilter<Hit>>(best: &mut Option<Hit>, t_max: &mut f32, filter: &mut F, hit: Hit) {
     let better = match *best {
         None => true,
-        Some(b) => t < b.t || (t == b.t && prim < b.prim),
+        Some(b) => hit.t < b.t || (hit.t == b.t && hit.prim < b.prim),
     };
-    if better {
-        *best = Some(Hit { t, prim, u, v });
-        *t_max = t;
+    if better && (F::ACCEPTS_ALL || filter.accept(&hit)) {
+        *best = Some(hit);
+        *t_max = hit.t;
     }
 }
 
-impl<C: Counters> Leaves<C> for TriangleLeaves<'_> {
+impl<C: Counters, F: HitFilter<Hit>> Leaves<C> for TriangleLeaves<'_, F> {
     #[inline(always)]
     fn closest(&mut self, first: u32, count: u32, counters: &mut C) {
         let source = self.source;
@@ -253,7 +336,8 @@ impl<C: Counters> Leaves<C> for TriangleLeaves<'_> {
                 let lane = mask.trailing_zeros() as usize;
                 mask &= mask - 1;
                 if block.ids[lane] != UNUSED {
-                    offer(&mut self.best, &mut self.t_max, block.ids[lane], hits.t[lane], hits.u[lane], hits.v[lane]);
+                    let hit = Hit { t: hits.t[lane], prim: block.ids[lane], u: hits.u[lane], v: hits.v[lane] };
+                    offer(&mut self.best, &mut self.t_max, &mut self.filter, hit);
                 }
             }
             let mut mask = hits.special;
@@ -263,7 +347,8 @@ impl<C: Counters> Leaves<C> for TriangleLeaves<'_> {
                 if block.ids[lane] != UNUSED
                     && let Some(h) = ray.scalar(block, lane, self.t_max)
                 {
-                    offer(&mut self.best, &mut self.t_max, block.ids[lane], h.t, h.u, h.v);
+                    let hit = Hit { t: h.t, prim: block.ids[lane], u: h.u, v: h.v };
+                    offer(&mut self.best, &mut self.t_max, &mut self.filter, hit);
                 }
             }
         }
@@ -302,15 +387,34 @@ impl<C: Counters> Leaves<C> for TriangleLeaves<'_> {
                 counters.exact_test();
             }
             let hits = intersect_block(block, ray, self.t_max);
-            // An unused lane repeats a used one: its hit is that lane's.
-            if hits.hit != 0 {
-                return true;
+            if F::ACCEPTS_ALL {
+                // An unused lane repeats a used one: its hit is that lane's.
+                if hits.hit != 0 {
+                    return true;
+                }
+            } else {
+                let mut mask = hits.hit;
+                while mask != 0 {
+                    let lane = mask.trailing_zeros() as usize;
+                    mask &= mask - 1;
+                    let hit = Hit { t: hits.t[lane], prim: block.ids[lane], u: hits.u[lane], v: hits.v[lane] };
+                    if block.ids[lane] != UNUSED && self.filter.accept(&hit) {
+                        return true;
+                    }
+                }
             }
             let mut mask = hits.special;
             while mask != 0 {
                 let lane = mask.trailing_zeros() as usize;
                 mask &= mask - 1;
-                if ray.scalar(block, lane, self.t_max).is_some() {
+                if F::ACCEPTS_ALL {
+                    if ray.scalar(block, lane, self.t_max).is_some() {
+                        return true;
+                    }
+                } else if block.ids[lane] != UNUSED
+                    && let Some(h) = ray.scalar(block, lane, self.t_max)
+                    && self.filter.accept(&Hit { t: h.t, prim: block.ids[lane], u: h.u, v: h.v })
+                {
                     return true;
                 }
             }

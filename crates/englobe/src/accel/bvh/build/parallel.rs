@@ -35,6 +35,19 @@ pub fn fill_indexed<T: Send>(out: &mut [T], min_chunk: usize, f: impl Fn(usize) 
     }
 }
 
+/// Runs `f` on every element of `v`, in parallel (in chunks of at least `min_chunk`) when the
+/// `parallel` feature is on and `v` is long enough; true if `f` returned true for all of them.
+#[inline]
+pub fn all_mut<T: Send>(v: &mut [T], min_chunk: usize, f: impl Fn(&mut T) -> bool + Sync) -> bool {
+    #[cfg(feature = "parallel")]
+    if v.len() > min_chunk {
+        use rayon::prelude::*;
+        return v.par_iter_mut().with_min_len(min_chunk.max(1)).map(&f).reduce(|| true, |a, b| a & b);
+    }
+    let _ = min_chunk;
+    v.iter_mut().fold(true, |ok, x| f(x) & ok)
+}
+
 /// Sorts `v` (unstably: give keys that are unique, or equal elements that are identical, for a
 /// deterministic order), in parallel when the `parallel` feature is on and `v` is long.
 #[inline]

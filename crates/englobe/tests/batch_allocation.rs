@@ -1,0 +1,80 @@
+//! Batches allocate nothing per ray: a counting global allocator watches a batch below the
+//! parallel threshold (nothing at all) and a large one (the thread pool's bookkeeping only, far
+//! fewer allocations than rays). One test in this binary, so that no other test's allocations
+//! are counted.
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use englobe::accel::PARALLEL_BATCH;
+use englobe::{AccelKind, Object, Ray, Sphere, TriangleMesh, Vec3, World};
+
+struct Counting;
+
+static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
+
+// SAFETY: forwards to the system allocator, only counting calls.
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        // SAFETY: the caller's guarantees, passed on.
+        unsafe { System.alloc(layout) }
+    }
+
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        // SAFETY: as above.
+        unsafe { System.dealloc(ptr, layout) }
+    }
+
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        // SAFETY: as above.
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+fn allocations_during(f: impl FnOnce()) -> usize {
+    let before = ALLOCATIONS.load(Ordering::SeqCst);
+    f();
+    ALLOCATIONS.load(Ordering::SeqCst) - before
+}
+
+#[test]
+fn batches_allocate_nothing_per_ray() {
+    let (mut vertices, mut triangles) = (Vec::new(), Vec::new());
+    for i in 0..40u32 {
+        for j in 0..40u32 {
+            let base = vertices.len() as u32;
+            let o = [i as f32, j as f32, ((i * 7 + j * 3) % 5) as f32];
+            vertices.extend([o, [o[0] + 1.0, o[1], o[2]], [o[0], o[1] + 1.0, o[2]]]);
+            triangles.push([base, base + 1, base + 2]);
+        }
+    }
+    let objects: Vec<Object> = vec![
+        TriangleMesh::from_arrays(&vertices, &triangles).unwrap().into(),
+        Sphere::new(Vec3::new(20.0, 20.0, 8.0), 3.0).into(),
+    ];
+    let world = World::build(objects, AccelKind::BvhWide).unwrap();
+    let rays: Vec<Ray> = (0..100_000)
+        .map(|k| {
+            let f = k as f32;
+            Ray::new(Vec3::new((f * 0.37) % 40.0, (f * 0.61) % 40.0, 12.0), Vec3::new(0.1, -0.05, -1.0))
+        })
+        .collect();
+    let small = &rays[..PARALLEL_BATCH - 1];
+    let (mut hits, mut mask) = (vec![None; small.len()], vec![false; small.len()]);
+    assert_eq!(allocations_during(|| world.closest_hits(small, &mut hits).unwrap()), 0);
+    assert_eq!(allocations_during(|| world.any_hits(small, &mut mask).unwrap()), 0);
+    assert!(hits.iter().filter(|h| h.is_some()).count() > small.len() / 4);
+    let (mut hits, mut mask) = (vec![None; rays.len()], vec![false; rays.len()]);
+    // The first parallel batch starts the thread pool.
+    world.closest_hits(&rays, &mut hits).unwrap();
+    let large = allocations_during(|| {
+        world.closest_hits(&rays, &mut hits).unwrap();
+        world.any_hits(&rays, &mut mask).unwrap();
+    });
+    assert!(large < rays.len() / 100, "{large} allocations for {} rays", 2 * rays.len());
+}
