@@ -76,11 +76,9 @@ mod x86 {
                 let o = _mm256_set1_ps(ray.origin[a]);
                 let inv = _mm256_set1_ps(ray.inv_dir[a]);
                 let inv_far = _mm256_set1_ps(ray.inv_far[a]);
-                // The rows from the direction's sign bit (as `NodeRay::near` and `far` hold
-                // them): indices the compiler sees are in bounds, so no check per row.
-                let down = (ray.negative_bits >> a & 1) as usize;
-                let near = _mm256_load_ps(node.bounds[2 * a + down].as_ptr());
-                let far = _mm256_load_ps(node.bounds[2 * a + 1 - down].as_ptr());
+                // The rows at the byte offsets the ray holds: no index check, no shift per row.
+                let near = _mm256_load_ps(ray.row(node, a, 0).as_ptr());
+                let far = _mm256_load_ps(ray.row(node, a, 1).as_ptr());
                 let t_near = _mm256_mul_ps(_mm256_sub_ps(near, o), inv);
                 let t_far = _mm256_mul_ps(_mm256_sub_ps(far, o), inv_far);
                 // `max(a, b)` is `a > b ? a : b`, `b` when either is NaN: the scalar rule.

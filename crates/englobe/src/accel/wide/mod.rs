@@ -16,7 +16,7 @@
 //! * [`node`]: the 256-byte node, child references, the scalar reference slab test.
 //! * [`convert`](mod@convert): binary tree to wide nodes (largest boxes pulled up first).
 //! * [`isa`]: the instruction sets, detected at run time; [`kernels`]: the slab test of eight
-//!   children for each; [`dispatch`]: the per-query choice.
+//!   children for each; `dispatch` (inside the crate): the per-query choice.
 //! * [`traverse`]: the single-ray traversal, generic over kernels and leaves.
 //! * [`triangles`]: blocks of four triangles and their SIMD watertight test; [`triangle_bvh`]:
 //!   [`TriangleBvh`].
@@ -28,7 +28,9 @@
 
 pub mod box_query;
 pub mod convert;
-pub mod dispatch;
+// The per-query choice of compiled kernels: safe to call only with a structure's own nodes and
+// instruction set, so it stays inside the crate.
+pub(crate) mod dispatch;
 pub mod isa;
 pub mod kernels;
 pub mod node;

@@ -116,6 +116,10 @@ pub struct NodeRay {
     pub t_min: f32,
     /// Bit `a` set if the ray goes down axis `a`.
     pub negative_bits: u32,
+    /// Byte offsets of the near and far rows of each axis in [`WideNode::bounds`], for kernels
+    /// that load rows without an index check. Private, so that only [`NodeRay::new`] makes them,
+    /// always below `ROWS * WIDTH * 4`.
+    row_bytes: [[usize; 2]; 3],
 }
 
 impl NodeRay {
@@ -140,7 +144,20 @@ impl NodeRay {
             far,
             t_min: ray.t_min,
             negative_bits,
+            row_bytes: [0, 1, 2].map(|a| [near[a], far[a]].map(|row| row * WIDTH * 4)),
         }
+    }
+}
+
+impl NodeRay {
+    /// The near (`side` 0) or far (`side` 1) row of `axis` of `node`, without an index check.
+    #[inline(always)]
+    pub fn row<'a>(&self, node: &'a WideNode, axis: usize, side: usize) -> &'a [f32; WIDTH] {
+        debug_assert!(axis < 3 && side < 2);
+        let offset = self.row_bytes[axis][side];
+        // SAFETY: `NodeRay::new`, the only maker of `row_bytes`, gives each the start of a row of
+        // `bounds` (row < ROWS), a multiple of a row's size; rows are arrays of WIDTH floats.
+        unsafe { &*((node.bounds.as_ptr() as *const u8).add(offset) as *const [f32; WIDTH]) }
     }
 }
 

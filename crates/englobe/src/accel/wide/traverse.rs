@@ -11,7 +11,7 @@
 //!
 //! The traversal is generic over the node test ([`NodeKernel`], one per instruction set) and over
 //! what leaves hold ([`Leaves`]: primitive references tested by a closure, or blocks of
-//! triangles). [`dispatch`](super::dispatch) calls the instance compiled for the structure's instruction set.
+//! triangles). The crate's `dispatch` module calls the instance compiled for the structure's instruction set.
 //!
 //! The stack holds at most seven entries per level of the path from the root, so the tree's
 //! recorded depth bounds it: trees up to [`INLINE_DEPTH`] levels deep use an uninitialised array on
@@ -132,7 +132,8 @@ fn give_back(deep: Vec<MaybeUninit<Entry>>) {
 ///
 /// # Safety
 /// As [`NodeKernel::children`]: compiled with the kernel's target features, run on a processor
-/// that has them.
+/// that has them; and every interior child reference in `nodes` indexes `nodes`, as in every tree
+/// the builders make (the structures' validators check it).
 #[inline(always)]
 pub unsafe fn closest<K: NodeKernel, C: Counters, L: Leaves<C>>(
     kernel: K,
@@ -153,7 +154,9 @@ pub unsafe fn closest<K: NodeKernel, C: Counters, L: Leaves<C>>(
             if is_leaf(current.reference) {
                 leaves.closest(index_of(current.reference), current.count, counters);
             } else {
-                let node = &nodes[current.reference as usize];
+                debug_assert!((current.reference as usize) < nodes.len());
+                // SAFETY: the caller's guarantee: interior references index `nodes`.
+                let node = unsafe { nodes.get_unchecked(current.reference as usize) };
                 counters.node_visited();
                 counters.box_tests(WIDTH as u32);
                 // SAFETY: the caller's guarantee.
@@ -255,7 +258,9 @@ pub unsafe fn any<K: NodeKernel, C: Counters, L: Leaves<C>>(
                     break 'walk true;
                 }
             } else {
-                let node = &nodes[current.reference as usize];
+                debug_assert!((current.reference as usize) < nodes.len());
+                // SAFETY: the caller's guarantee: interior references index `nodes`.
+                let node = unsafe { nodes.get_unchecked(current.reference as usize) };
                 counters.node_visited();
                 counters.box_tests(WIDTH as u32);
                 // SAFETY: the caller's guarantee.
