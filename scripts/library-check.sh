@@ -11,3 +11,4 @@ cargo test -p englobe --doc
 cargo run -p englobe --example line_of_sight -- 32 6
 cargo run -p englobe --example audio_occlusion -- 4
 cargo run -p englobe --example lidar_scan -- 64 3
+cargo run -p englobe --example moving_instances -- 500 3

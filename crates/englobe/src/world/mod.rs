@@ -29,6 +29,7 @@ use glam::Vec3;
 
 mod batch;
 mod bottom;
+mod motion;
 mod object;
 mod proximity;
 mod query;
@@ -55,6 +56,41 @@ pub enum WorldError {
     /// More primitives than a structure can hold ([`MAX_PRIMITIVES`]).
     #[error("too many primitives: {0}")]
     TooManyPrimitives(usize),
+    /// [`World::move_instances`] was asked to move an object that is not an instance.
+    #[error("object {object} is not an instance: only instances move")]
+    NotAnInstance {
+        /// Object index.
+        object: usize,
+    },
+    /// [`World::move_instances`] was given a transform the instance refuses.
+    #[error("object {object}: {source}")]
+    Instance {
+        /// Object index.
+        object: usize,
+        /// Why.
+        #[source]
+        source: crate::shapes::InstanceError,
+    },
+}
+
+/// The structure `kind` over every primitive (the teaching structures hold them all in one), with
+/// split clipping: a triangle's exact part in a cell, any other shape's box's part.
+fn accel_over_all(
+    kind: AccelKind,
+    objects: &[Object],
+    prim_object: &[u32],
+    object_first_prim: &[u32],
+    boxes: &[Aabb],
+) -> AnyAccel {
+    let clip = |prim: u32, cell: &Aabb| {
+        let object = prim_object[prim as usize];
+        match &objects[object as usize] {
+            Object::Mesh(m) => clip_triangle(m.triangle(prim - object_first_prim[object as usize]).vertices, cell),
+            Object::Shape(Shape::Triangle(t)) => clip_triangle(t.vertices, cell),
+            _ => boxes[prim as usize].intersection(cell),
+        }
+    };
+    AnyAccel::build_with_clipper(kind, boxes, &clip)
 }
 
 /// Where a ray hit a world.
@@ -191,18 +227,7 @@ impl World {
                 (AnyAccel::build(kind, &other_boxes), Some(others), Some(triangles))
             }
         } else {
-            // Split clipping: a triangle's exact part in a cell, any other shape's box's part.
-            let clip = |prim: u32, cell: &Aabb| {
-                let object = prim_object[prim as usize];
-                match &objects[object as usize] {
-                    Object::Mesh(m) => {
-                        clip_triangle(m.triangle(prim - object_first_prim[object as usize]).vertices, cell)
-                    }
-                    Object::Shape(Shape::Triangle(t)) => clip_triangle(t.vertices, cell),
-                    _ => boxes[prim as usize].intersection(cell),
-                }
-            };
-            (AnyAccel::build_with_clipper(kind, &boxes, &clip), None, None)
+            (accel_over_all(kind, &objects, &prim_object, &object_first_prim, &boxes), None, None)
         };
         drop(boxes);
         let (bottom, object_bottom) = bottom::build_bottom_levels(&objects, kind);
