@@ -1,7 +1,9 @@
-//! One benchmark run: for each scene, the ray sets are generated once; then for each thread count
-//! and library, the library is built (timed), every cell is traced (timed) and its answers are
-//! checked against brute force; a table is printed per scene and thread count, and the CSV is
-//! written at the end, its path printed last.
+//! One benchmark run: every scene file is read first, so that a bad one stops the run before
+//! anything is measured; then for each scene, the ray sets are generated once, and for each
+//! thread count and library, the library is built (timed), every cell is traced (timed) and its
+//! answers are checked against brute force. A table is printed per scene and thread count; the
+//! CSV is rewritten (atomically) after every measurement, so that a crash or an interrupt keeps
+//! everything measured until then; its path is printed last.
 
 use std::collections::BTreeMap;
 use std::io::Write as _;
@@ -37,6 +39,12 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<ExitCode> {
             eprintln!("{msg}");
         }
     };
+    // Every file read before anything is measured: a bad file at the end of the list must not
+    // cost the measurements before it. (Tiled scenes are checked untiled: tiling cannot fail.)
+    for spec in &args.scenes {
+        BenchScene::load(&spec.name, &spec.path, None)
+            .with_context(|| format!("scene `{}` refused before measuring anything", spec.name))?;
+    }
     println!("englobe-bench on {}", report::machine_description());
     println!("englobe structure: {englobe}; seed {}", args.seed);
 
@@ -97,6 +105,8 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<ExitCode> {
                         ));
                     }
                     all.push(Measurement { library: kind, threads, build_ms, ..m });
+                    results::fill_ratios(&mut all);
+                    results::write_atomically(&args.csv, &results::to_csv(&all))?;
                 }
             }
             results::fill_ratios(&mut all);

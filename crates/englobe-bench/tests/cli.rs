@@ -114,3 +114,33 @@ fn bad_input_is_refused_with_a_clear_error() {
         assert!(err.contains(expected), "{args:?}: {err}");
     }
 }
+
+#[test]
+fn a_bad_file_anywhere_in_the_list_stops_the_run_before_anything_is_measured() {
+    let dir = tempfile::tempdir().unwrap();
+    let broken = dir.path().join("broken.obj");
+    std::fs::write(&broken, "v 0 0 0\nv 1 0 0\nf 1 2 7\n").unwrap();
+    let csv = dir.path().join("bench.csv");
+    let good = format!("box={}", cornell_box());
+    let bad = format!("bad={}", broken.display());
+    let out = bench(&[
+        &good,
+        &bad,
+        "--resolution",
+        "32",
+        "--rays",
+        "500",
+        "--reps",
+        "1",
+        "--threads",
+        "1",
+        "-o",
+        csv.to_str().unwrap(),
+        "-q",
+    ]);
+    assert!(!out.status.success());
+    let err = text(&out.stderr);
+    assert!(err.contains("scene `bad` refused before measuring anything") && err.contains("broken.obj"), "{err}");
+    assert!(!text(&out.stdout).contains("rays hitting"), "nothing was measured: {}", text(&out.stdout));
+    assert!(!csv.exists());
+}
