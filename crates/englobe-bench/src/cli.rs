@@ -9,7 +9,7 @@ use crate::agreement::DEFAULT_MISMATCH_TOLERANCE;
 use crate::rays::{DEFAULT_RAY_COUNT, DEFAULT_RESOLUTION, DEFAULT_SEED};
 use crate::registry::LibraryKind;
 use crate::report::Cell;
-use crate::scene::SceneSpec;
+use crate::scene::{SceneSpec, ViewSpec};
 
 /// Largest primary image side accepted.
 pub const MAX_RESOLUTION: u32 = 4096;
@@ -25,6 +25,11 @@ pub struct BenchArgs {
     /// tiled into a grid of copies (`bunny-16=bunny.obj@4x2x2`).
     #[arg(required = true, value_parser = SceneSpec::parse, value_name = "SCENE")]
     pub scenes: Vec<SceneSpec>,
+    /// A camera inside a scene for its primary rays, instead of the one that frames the mesh from
+    /// outside: `NAME=EX,EY,EZ,DX,DY,DZ,FOV` (eye, direction, field of view in degrees, up +y;
+    /// repeatable). The Sponza from inside: `sponza=-10.43876,7.37331,0.00149,1,0,0,60`.
+    #[arg(long, value_parser = ViewSpec::parse, value_name = "NAME=EYE,DIR,FOV")]
+    pub view: Vec<ViewSpec>,
     /// Thread counts to measure, comma-separated.
     #[arg(long, value_delimiter = ',', default_values_t = [1usize, 2])]
     pub threads: Vec<usize>,

@@ -131,9 +131,23 @@ pub fn primary_rays(scene: &BenchScene, size: u32) -> Vec<BenchRay> {
     (0..(size as usize * size as usize))
         .map(|i| {
             let (x, y) = primary_pixel(i, size);
-            camera.ray(x, y, size)
+            match &scene.view {
+                Some(view) => view_ray(view, x, y, size),
+                None => camera.ray(x, y, size),
+            }
         })
         .collect()
+}
+
+/// The ray through the centre of pixel `(x, y)` (y down) of a `size x size` image seen from
+/// `view`.
+pub fn view_ray(view: &crate::scene::View, x: u32, y: u32, size: u32) -> BenchRay {
+    let right = view.dir.cross(Vec3::Y).normalize();
+    let up = right.cross(view.dir);
+    let tan = (0.5 * view.fov_degrees.to_radians()).tan();
+    let sx = (2.0 * (x as f32 + 0.5) / size as f32 - 1.0) * tan;
+    let sy = (1.0 - 2.0 * (y as f32 + 0.5) / size as f32) * tan;
+    BenchRay::new(view.eye, (view.dir + right * sx + up * sy).normalize())
 }
 
 /// A uniform direction on the unit sphere from two uniform numbers in `[0, 1)`.

@@ -45,13 +45,17 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<ExitCode> {
         BenchScene::load(&spec.name, &spec.path, None)
             .with_context(|| format!("scene `{}` refused before measuring anything", spec.name))?;
     }
+    if let Some(v) = args.view.iter().find(|v| !args.scenes.iter().any(|s| s.name == v.scene)) {
+        bail!("--view {}=...: no scene of that name", v.scene);
+    }
     println!("englobe-bench on {}", report::machine_description());
     println!("englobe structure: {englobe}; seed {}", args.seed);
 
     let mut all = Vec::new();
     let mut failures = Vec::new();
     for spec in &args.scenes {
-        let scene = BenchScene::load(&spec.name, &spec.path, spec.tiling)?;
+        let mut scene = BenchScene::load(&spec.name, &spec.path, spec.tiling)?;
+        scene.view = args.view.iter().rev().find(|v| v.scene == scene.name).map(|v| v.view);
         progress(format!("{}: {} triangles; generating rays", scene.name, scene.triangle_count()));
         let params = RayParams { resolution: args.resolution, count: args.rays, seed: args.seed };
         let sets = generate_rays(&scene, params, max_threads)?;

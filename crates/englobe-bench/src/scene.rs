@@ -42,6 +42,53 @@ pub struct BenchScene {
     pub name: String,
     /// The triangles (degenerate ones already dropped by the loader).
     pub mesh: Arc<TriangleMesh>,
+    /// Where the primary rays come from, if not from the camera that frames the mesh's bounding
+    /// sphere: a camera inside the scene, as a renderer's would be.
+    pub view: Option<View>,
+}
+
+/// A pinhole camera for the primary rays: square image, up +y.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct View {
+    /// Eye position.
+    pub eye: Vec3,
+    /// Viewing direction (unit).
+    pub dir: Vec3,
+    /// Field of view, in degrees, across the (square) image.
+    pub fov_degrees: f32,
+}
+
+/// A view for the scene `name`: `NAME=EX,EY,EZ,DX,DY,DZ,FOV` on the command line.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ViewSpec {
+    /// The scene it is for.
+    pub scene: String,
+    /// The camera.
+    pub view: View,
+}
+
+impl ViewSpec {
+    /// Parses `NAME=EX,EY,EZ,DX,DY,DZ,FOV`.
+    pub fn parse(s: &str) -> Result<Self, String> {
+        let bad = || format!("`{s}`: expected NAME=EX,EY,EZ,DX,DY,DZ,FOV (eye, direction, field of view in degrees)");
+        let (scene, numbers) = s.split_once('=').ok_or_else(bad)?;
+        let n: Vec<f32> =
+            numbers.split(',').map(|x| x.trim().parse::<f32>().map_err(|_| bad())).collect::<Result<_, _>>()?;
+        let [ex, ey, ez, dx, dy, dz, fov] = n[..] else { return Err(bad()) };
+        let (eye, dir) = (Vec3::new(ex, ey, ez), Vec3::new(dx, dy, dz));
+        if scene.is_empty()
+            || !eye.is_finite()
+            || !dir.is_finite()
+            || dir.length() == 0.0
+            || !(fov > 0.0 && fov < 180.0)
+        {
+            return Err(bad());
+        }
+        if dir.normalize().cross(Vec3::Y).length() < 1e-3 {
+            return Err(format!("`{s}`: the direction must not be vertical (the image's up is +y)"));
+        }
+        Ok(ViewSpec { scene: scene.to_owned(), view: View { eye, dir: dir.normalize(), fov_degrees: fov } })
+    }
 }
 
 impl BenchScene {
@@ -55,12 +102,12 @@ impl BenchScene {
         if let Some(t) = tiling {
             mesh = tile(&mesh, t)?;
         }
-        Ok(BenchScene { name: name.to_owned(), mesh: Arc::new(mesh) })
+        Ok(BenchScene { name: name.to_owned(), mesh: Arc::new(mesh), view: None })
     }
 
     /// A scene from a mesh already in memory.
     pub fn from_mesh(name: &str, mesh: TriangleMesh) -> Self {
-        BenchScene { name: name.to_owned(), mesh: Arc::new(mesh) }
+        BenchScene { name: name.to_owned(), mesh: Arc::new(mesh), view: None }
     }
 
     /// Number of triangles.

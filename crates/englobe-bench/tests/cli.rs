@@ -144,3 +144,29 @@ fn a_bad_file_anywhere_in_the_list_stops_the_run_before_anything_is_measured() {
     assert!(!text(&out.stdout).contains("rays hitting"), "nothing was measured: {}", text(&out.stdout));
     assert!(!csv.exists());
 }
+
+#[test]
+fn a_camera_inside_the_sponza_sees_walls_in_almost_every_pixel() {
+    let meshes = shared_meshes_or_panic(Path::new(env!("CARGO_MANIFEST_DIR")));
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("bench.csv");
+    let sponza = meshes.join("sponza-dabrovic/sponza.obj").to_string_lossy().into_owned();
+    let scenes = [format!("outside={sponza}"), format!("inside={sponza}")];
+    let common = ["--resolution", "64", "--rays", "500", "--reps", "1", "--threads", "1", "--libraries", "englobe"];
+    let mut args: Vec<&str> = scenes.iter().map(String::as_str).collect();
+    args.extend(common);
+    args.extend(["--view", "inside=-10.43876,7.37331,0.00149,1,0,0,60", "-o", csv.to_str().unwrap(), "-q"]);
+    let out = bench(&args);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let stdout = text(&out.stdout);
+    let primary = |scene: &str| -> f64 {
+        let line = stdout.lines().find(|l| l.starts_with(&format!("{scene}:")) && l.contains("rays hitting")).unwrap();
+        line.split("primary ").nth(1).unwrap().split(" %").next().unwrap().parse().unwrap()
+    };
+    assert!(primary("inside") > 90.0, "{stdout}");
+    assert!(primary("outside") < 50.0, "the framing camera sees the building from outside: {stdout}");
+    let err = text(&bench(&[&scenes[0], "--view", "nowhere=0,0,0,1,0,0,60", "-q"]).stderr);
+    assert!(err.contains("--view nowhere=...: no scene of that name"), "{err}");
+    let err = text(&bench(&[&scenes[0], "--view", "outside=0,0,0,0,1,0,60", "-q"]).stderr);
+    assert!(err.contains("must not be vertical"), "{err}");
+}
