@@ -22,7 +22,7 @@ use crate::camera::PinholeCamera;
 use crate::cost::CostImage;
 use crate::film::Film;
 use crate::path::PathTracer;
-use crate::stats::{RayKind, RenderStats, Tally};
+use crate::stats::{RenderStats, Tally};
 use crate::tile::PixelWindow;
 use crate::whitted::Whitted;
 
@@ -262,7 +262,7 @@ impl<'a> Renderer<'a> {
         let mut sample = |rng: &mut Pcg32, dx: f32, dy: f32| {
             let ray = camera.ray(x as f32 + dx, y as f32 + dy);
             match integrator {
-                Integrator::Whitted(w) => w.radiance(&ray, RayKind::Primary, 0, tally),
+                Integrator::Whitted(w) => w.radiance(&ray, tally),
                 Integrator::Path(p) => p.radiance(&ray, rng, tally),
             }
         };

@@ -8,6 +8,12 @@
 //! material's reflectivity and transparency, and `F` the Fresnel reflectance of the dielectric
 //! (1 under total internal reflection). A material with `kt = 1`, index 1 and no highlight is thus
 //! exactly invisible: its colour is `T`, and `T` is the colour behind it.
+//!
+//! Adaptive depth (Hall and Greenberg 1983, "A Testbed for Realistic Image Synthesis"): a
+//! secondary ray's contribution to its pixel is the product of the factors (`kr`, `kt (1 - F)`,
+//! ...) along its path; with the scene's `min_contribution`, a ray whose contribution would fall
+//! below it is not cast, so that deep trees are cut where they no longer change the pixel, instead
+//! of at one fixed depth for every path.
 
 use englobe::{Counters, Ray, Vec3, World};
 use englobe_scene::Scene;
@@ -28,8 +34,14 @@ impl<'a> Whitted<'a> {
         Whitted { scene, world }
     }
 
-    /// The colour seen along `ray`, a ray of `kind` at recursion `depth` (0 for primary rays).
-    pub fn radiance<C: Counters>(&self, ray: &Ray, kind: RayKind, depth: u32, tally: &mut Tally<C>) -> Vec3 {
+    /// The colour seen along a primary `ray`.
+    pub fn radiance<C: Counters>(&self, ray: &Ray, tally: &mut Tally<C>) -> Vec3 {
+        self.trace(ray, RayKind::Primary, 0, 1.0, tally)
+    }
+
+    /// The colour seen along `ray`, a ray of `kind` at recursion `depth` (0 for primary rays)
+    /// whose colour reaches the pixel multiplied by `weight`.
+    fn trace<C: Counters>(&self, ray: &Ray, kind: RayKind, depth: u32, weight: f32, tally: &mut Tally<C>) -> Vec3 {
         tally.rays[kind as usize] += 1;
         let Some(hit) = self.world.closest_hit(ray, &mut tally.work[kind as usize]) else {
             return self.scene.image.background;
@@ -44,6 +56,7 @@ impl<'a> Whitted<'a> {
         if depth >= self.scene.image.max_depth {
             return color;
         }
+        let worth = |factor: f32| weight * factor >= self.scene.image.min_contribution;
         let mut mirror_weight = kr;
         if kt > 0.0 {
             let eta = if s.entering { 1.0 / m.ior } else { m.ior };
@@ -53,14 +66,18 @@ impl<'a> Whitted<'a> {
                     let cos_i = -s.d.dot(s.n);
                     let f = fresnel_dielectric(cos_i, cos_t, eta);
                     mirror_weight += kt * f;
-                    let refracted = Ray::new(s.inside(), t_dir);
-                    color += self.radiance(&refracted, RayKind::Refracted, depth + 1, tally) * (kt * (1.0 - f));
+                    let factor = kt * (1.0 - f);
+                    if worth(factor) {
+                        let refracted = Ray::new(s.inside(), t_dir);
+                        color += self.trace(&refracted, RayKind::Refracted, depth + 1, weight * factor, tally) * factor;
+                    }
                 }
             }
         }
-        if mirror_weight > 0.0 {
+        if mirror_weight > 0.0 && worth(mirror_weight) {
             let reflected = Ray::new(s.outside(), reflect(s.d, s.n));
-            color += self.radiance(&reflected, RayKind::Reflected, depth + 1, tally) * mirror_weight;
+            color +=
+                self.trace(&reflected, RayKind::Reflected, depth + 1, weight * mirror_weight, tally) * mirror_weight;
         }
         color
     }

@@ -53,6 +53,7 @@ pub struct ImageDef {
     pub samples: u32,
     #[serde(default = "five")]
     pub max_depth: u32,
+    pub min_contribution: Option<crate::numbers::Fraction>,
     pub background: Option<Color>,
     pub ambient: Option<Color>,
     #[serde(default)]

@@ -24,6 +24,10 @@ pub struct ImageSettings {
     pub samples: u32,
     /// Maximum number of reflection/refraction bounces after the primary ray.
     pub max_depth: u32,
+    /// Adaptive depth (Hall and Greenberg 1983): a reflected or refracted ray is cast only while
+    /// its contribution to the pixel, the product of the reflection and transmission factors
+    /// along its path, is at least this; 0 (the default) casts every ray up to `max_depth`.
+    pub min_contribution: f32,
     /// Colour of rays that hit nothing (linear RGB).
     pub background: Vec3,
     /// Light that reaches every point, scaled by the diffuse colour (the classic ambient term).

@@ -166,6 +166,7 @@ impl Converter<'_> {
             height,
             samples: i.samples,
             max_depth: i.max_depth,
+            min_contribution: i.min_contribution.map_or(0.0, |f| f.0),
             background: i.background.map_or(Vec3::ZERO, |c| c.0),
             ambient: i.ambient.map_or(Vec3::ZERO, |c| c.0),
             seed: i.seed,
