@@ -1,13 +1,14 @@
 //! `englobe experiment seed`: the seed report's four tests with every accelerator, beside the
-//! report's figures (see `englobe_lab::seed_experiment`). This file parses the arguments and
-//! prints what the experiment returns.
+//! report's figures (see `englobe_lab::seed_experiment`); `englobe experiment fewer-rays`: the
+//! report's other family of speed-ups, measured (see `englobe_lab::fewer_rays`). This file parses
+//! the arguments and prints what the experiments return.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Args, ValueEnum};
 use englobe::AccelKind;
-use englobe_lab::{SeedOptions, run_seed};
+use englobe_lab::{FewerRaysOptions, SeedOptions, run_fewer_rays, run_seed};
 
 use crate::image_options::parse_accel;
 
@@ -16,6 +17,10 @@ use crate::image_options::parse_accel;
 pub enum Experiment {
     /// The seed report's four tests.
     Seed,
+    /// Fewer rays: adaptive depth at several thresholds against full depth, on the seed's scenes,
+    /// the glass, mirrors and Sponza scenes (or the SCENEs given): rays per kind, exact tests,
+    /// time, and the image's difference (RMSE, SSIM).
+    FewerRays,
 }
 
 #[derive(Args)]
@@ -23,7 +28,14 @@ pub struct ExperimentArgs {
     /// Which experiment.
     #[arg(value_enum)]
     experiment: Experiment,
-    /// Image width and height in pixels (default: the scenes' own, 512, like the report's).
+    /// fewer-rays: the scene files (default: the seed's four tests, glass, mirrors and Sponza,
+    /// from the repository's `scenes/`).
+    scenes: Vec<PathBuf>,
+    /// fewer-rays: the adaptive-depth thresholds, comma-separated (default 0.1,0.03,0.01,0.003).
+    #[arg(long, value_delimiter = ',')]
+    thresholds: Vec<f32>,
+    /// Image width and height in pixels (default: the scenes' own, 512, like the report's); for
+    /// fewer-rays, the longer side (default 320).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
     size: Option<u32>,
     /// Only these tests (1 to 4), comma-separated (default: all).
@@ -48,7 +60,10 @@ pub struct ExperimentArgs {
 }
 
 pub fn run(args: ExperimentArgs) -> anyhow::Result<ExitCode> {
-    let Experiment::Seed = args.experiment;
+    if args.experiment == Experiment::FewerRays {
+        return fewer_rays(args);
+    }
+    anyhow::ensure!(args.scenes.is_empty() && args.thresholds.is_empty(), "scenes and --thresholds are for fewer-rays");
     let options = SeedOptions {
         size: args.size,
         tests: args.tests,
@@ -70,6 +85,31 @@ pub fn run(args: ExperimentArgs) -> anyhow::Result<ExitCode> {
     if !experiment.images_identical() {
         eprintln!("error: some accelerators drew a different image than brute force (see the image column)");
         return Ok(ExitCode::from(2));
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn fewer_rays(args: ExperimentArgs) -> anyhow::Result<ExitCode> {
+    let mut options = FewerRaysOptions { threads: args.threads, ..FewerRaysOptions::default() };
+    if !args.scenes.is_empty() {
+        options.scenes = args.scenes;
+    }
+    if let Some(size) = args.size {
+        options.size = size;
+    }
+    if !args.thresholds.is_empty() {
+        anyhow::ensure!(args.thresholds.iter().all(|t| (0.0..=1.0).contains(t)), "--thresholds: each between 0 and 1");
+        options.thresholds = args.thresholds;
+    }
+    let quiet = args.quiet;
+    let experiment = run_fewer_rays(&options, &mut |line| {
+        if !quiet {
+            eprintln!("{line}");
+        }
+    })?;
+    print!("{}", experiment.table());
+    if let Some(path) = &args.json {
+        englobe_lab::report::write_json(path, &experiment)?;
     }
     Ok(ExitCode::SUCCESS)
 }

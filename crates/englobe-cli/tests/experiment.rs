@@ -169,3 +169,34 @@ fn cost_aov_writes_a_heatmap_with_its_scale() {
     let png = std::fs::read(&heat).unwrap();
     assert_eq!(&png[1..4], b"PNG");
 }
+
+#[test]
+fn fewer_rays_casts_fewer_secondary_rays_for_a_measured_difference() {
+    let dir = tempfile::tempdir().unwrap();
+    let json = dir.path().join("fewer.json");
+    let scenes = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
+    let out = englobe()
+        .args(["experiment", "fewer-rays", "--size", "64", "--thresholds", "0.1,0.001", "--quiet", "--json"])
+        .arg(&json)
+        .arg(scenes.join("glass.toml"))
+        .arg(scenes.join("cornell-box-path.toml"))
+        .output()
+        .expect("englobe runs");
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let table = String::from_utf8_lossy(&out.stdout);
+    assert!(table.contains("cornell-box-path.toml: path traced"), "{table}");
+    let report: Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let rows = rows(&report);
+    assert_eq!(rows.len(), 3, "the reference and two thresholds");
+    let secondary = |r: &Value| r["rays"][2].as_u64().unwrap() + r["rays"][3].as_u64().unwrap();
+    let (full, coarse, fine) = (&rows[0], &rows[1], &rows[2]);
+    assert_eq!(full["method"], "full depth");
+    assert_eq!(full["error"]["rmse"].as_f64(), Some(0.0));
+    assert!(secondary(coarse) < secondary(fine) && secondary(fine) <= secondary(full), "{table}");
+    let rmse = |r: &Value| r["error"]["rmse"].as_f64().unwrap();
+    assert!(rmse(coarse) > rmse(fine) && rmse(coarse) > 0.0, "{table}");
+    assert!(count(coarse, "exact_tests") < count(full, "exact_tests"));
+    for r in rows {
+        assert_eq!(r["rays"][0].as_u64(), full["rays"][0].as_u64(), "every pixel keeps its primary rays");
+    }
+}

@@ -1,7 +1,8 @@
 //! # englobe-lab
 //!
 //! englobe's research, as a library: the seed report's experiment ([`seed_experiment`], on the
-//! scenes and figures of [`seed_report`]) and the comparison of every acceleration structure on one
+//! scenes and figures of [`seed_report`]), its other family of speed-ups, fewer rays
+//! ([`fewer_rays`], with [`image_error`] saying what an image loses) and the comparison of every acceleration structure on one
 //! scene ([`compare`]), both built on [`measure`] (build, render, time, compare images); their
 //! reports ([`report`]: tables and JSON) and plot ([`plot`]: SVG). The `englobe` command parses its
 //! arguments and calls these; a program can call them as well:
@@ -21,6 +22,8 @@
 
 pub mod compare;
 pub mod error;
+pub mod fewer_rays;
+pub mod image_error;
 pub mod measure;
 pub mod memory;
 pub mod plot;
@@ -30,4 +33,5 @@ pub mod seed_report;
 
 pub use compare::{CompareOptions, CompareRow, Comparison, run_compare};
 pub use error::LabError;
+pub use fewer_rays::{FewerRays, FewerRaysOptions, run_fewer_rays};
 pub use seed_experiment::{SeedExperiment, SeedOptions, SeedRow, run_seed};

@@ -1,0 +1,181 @@
+//! The seed report's other family of speed-ups (its section 2.1): casting fewer rays, measured the
+//! seed's way: rays cast and exact tests per kind of ray, the time, and what the image loses
+//! against a full render (see [`crate::image_error`]).
+//!
+//! The method measured so far is adaptive depth (Hall and Greenberg 1983, "A Testbed for
+//! Realistic Image Synthesis"): secondary rays whose contribution to the pixel would fall below a
+//! threshold are not cast (the scene's `min_contribution`, see englobe-render's `whitted`). Each
+//! Whitted scene is rendered once at full depth (the reference) and once per threshold;
+//! path-traced scenes are skipped, their depth being a matter of Russian roulette, not of a fixed
+//! tree.
+
+use std::fmt::Write as _;
+use std::path::PathBuf;
+use std::time::Instant;
+
+use englobe::AccelKind;
+use englobe_render::{RayKind, RenderStats, Renderer};
+use englobe_scene::{IntegratorKind, Scene, load_scene};
+
+use crate::error::LabError;
+use crate::image_error::{ImageError, image_error};
+use crate::measure::{build, thread_pool};
+use crate::report::grouped;
+
+/// The scenes measured by default, relative to the repository's root: the seed report's four
+/// tests, the glass and mirror scenes (where rays branch most) and the Sponza.
+pub const DEFAULT_SCENES: [&str; 7] = [
+    "scenes/seed/test1.toml",
+    "scenes/seed/test2.toml",
+    "scenes/seed/test3.toml",
+    "scenes/seed/test4.toml",
+    "scenes/glass.toml",
+    "scenes/mirrors.toml",
+    "scenes/sponza.toml",
+];
+
+/// The adaptive-depth thresholds measured by default.
+pub const DEFAULT_THRESHOLDS: [f32; 4] = [0.1, 0.03, 0.01, 0.003];
+
+/// What to measure.
+#[derive(Clone, Debug)]
+pub struct FewerRaysOptions {
+    /// Scene files (default: [`DEFAULT_SCENES`]).
+    pub scenes: Vec<PathBuf>,
+    /// The longer side of the images, the other following the scene's aspect ratio (default 320).
+    pub size: u32,
+    /// Adaptive-depth thresholds (default: [`DEFAULT_THRESHOLDS`]).
+    pub thresholds: Vec<f32>,
+    /// Worker threads (default: all cores).
+    pub threads: Option<u32>,
+}
+
+impl Default for FewerRaysOptions {
+    fn default() -> Self {
+        FewerRaysOptions {
+            scenes: DEFAULT_SCENES.iter().map(PathBuf::from).collect(),
+            size: 320,
+            thresholds: DEFAULT_THRESHOLDS.to_vec(),
+            threads: None,
+        }
+    }
+}
+
+/// One render of one scene.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct FewerRaysRow {
+    /// The scene file.
+    pub scene: String,
+    /// `full depth` (the reference) or `adaptive depth`.
+    pub method: String,
+    /// The setting: the scene's maximum depth, or the threshold.
+    pub setting: String,
+    /// Rays cast per kind: primary, shadow, reflected, refracted.
+    pub rays: [u64; 4],
+    /// Exact tests, all kinds.
+    pub exact_tests: u64,
+    /// Seconds spent rendering (with counting on, as for every row).
+    pub seconds: f64,
+    /// Against the reference (zero for the reference itself).
+    pub error: ImageError,
+}
+
+/// The experiment's rows and the scenes it skipped, with why.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct FewerRays {
+    /// Every render.
+    pub rows: Vec<FewerRaysRow>,
+    /// Scenes not measured, and why.
+    pub skipped: Vec<String>,
+}
+
+/// Runs the experiment; `progress` gets a line per render.
+pub fn run_fewer_rays(options: &FewerRaysOptions, progress: &mut dyn FnMut(String)) -> Result<FewerRays, LabError> {
+    let pool = thread_pool(options.threads)?;
+    let mut out = FewerRays { rows: Vec::new(), skipped: Vec::new() };
+    for path in &options.scenes {
+        let name = path.display().to_string();
+        let mut scene = load_scene(path)?;
+        if scene.image.integrator != IntegratorKind::Whitted {
+            out.skipped.push(format!("{name}: path traced; adaptive depth applies to Whitted's recursion"));
+            continue;
+        }
+        let (w, h) = (scene.image.width as f64, scene.image.height as f64);
+        let scale = options.size as f64 / w.max(h);
+        scene.image.width = ((w * scale).round() as u32).max(1);
+        scene.image.height = ((h * scale).round() as u32).max(1);
+        scene.image.min_contribution = 0.0;
+        let (world, _) = build(&scene, AccelKind::BvhWide)?;
+        let render = |scene: &Scene| -> Result<(englobe_render::RenderOutput, f64), LabError> {
+            let start = Instant::now();
+            let out = pool.install(|| Renderer::new(scene, &world).count_work(true).render())?;
+            Ok((out, start.elapsed().as_secs_f64()))
+        };
+        progress(format!("{name}: full depth ({})", scene.image.max_depth));
+        let (reference, seconds) = render(&scene)?;
+        let row = |method: &str, setting: String, stats: &RenderStats, seconds: f64, error: ImageError| FewerRaysRow {
+            scene: name.clone(),
+            method: method.to_owned(),
+            setting,
+            rays: [RayKind::Primary, RayKind::Shadow, RayKind::Reflected, RayKind::Refracted]
+                .map(|k| stats.kind(k).rays),
+            exact_tests: stats.total().exact_tests,
+            seconds,
+            error,
+        };
+        let exact = image_error(&reference.film, &reference.film);
+        out.rows.push(row("full depth", format!("depth {}", scene.image.max_depth), &reference.stats, seconds, exact));
+        for &threshold in &options.thresholds {
+            progress(format!("{name}: adaptive depth {threshold}"));
+            let mut adaptive = scene.clone();
+            adaptive.image.min_contribution = threshold;
+            let (image, seconds) = render(&adaptive)?;
+            let error = image_error(&image.film, &reference.film);
+            out.rows.push(row("adaptive depth", format!("{threshold}"), &image.stats, seconds, error));
+        }
+    }
+    Ok(out)
+}
+
+impl FewerRays {
+    /// The table: one line per render, the rays of each kind, exact tests, time, and the error.
+    pub fn table(&self) -> String {
+        let mut s = String::new();
+        let _ = writeln!(
+            s,
+            "{:<24} {:<15} {:>8} {:>10} {:>10} {:>10} {:>10} {:>13} {:>7} {:>6} {:>7}",
+            "scene",
+            "method",
+            "setting",
+            "primary",
+            "shadow",
+            "reflected",
+            "refracted",
+            "exact tests",
+            "s",
+            "RMSE",
+            "SSIM"
+        );
+        for r in &self.rows {
+            let _ = writeln!(
+                s,
+                "{:<24} {:<15} {:>8} {:>10} {:>10} {:>10} {:>10} {:>13} {:>7.3} {:>6.2} {:>7.4}",
+                r.scene.trim_start_matches("scenes/"),
+                r.method,
+                r.setting,
+                grouped(r.rays[0]),
+                grouped(r.rays[1]),
+                grouped(r.rays[2]),
+                grouped(r.rays[3]),
+                grouped(r.exact_tests),
+                r.seconds,
+                r.error.rmse,
+                r.error.ssim
+            );
+        }
+        for skipped in &self.skipped {
+            let _ = writeln!(s, "skipped {skipped}");
+        }
+        s
+    }
+}
