@@ -100,15 +100,41 @@ impl Emitters {
     }
 }
 
-/// The power heuristic weight of a sample of density `pdf` against another technique's `other`.
+/// The power heuristic weight of a sample of density `pdf` against another technique's `other`
+/// (Veach and Guibas 1995): `pdf^2 / (pdf^2 + other^2)`, computed from the ratio of the two, so
+/// that a density whose square overflows `f32` (a light seen at a grazing angle from a point a
+/// million units away on an infinite plane has a density of 5e19) weighs 1, not `inf / inf`.
 pub fn power_heuristic(pdf: f32, other: f32) -> f32 {
-    let (a, b) = (pdf * pdf, other * other);
-    if a + b > 0.0 { a / (a + b) } else { 0.0 }
+    if !(pdf > 0.0) {
+        return 0.0;
+    }
+    let r = other / pdf;
+    if r.is_nan() {
+        // Both infinite: as likely as each other.
+        return 0.5;
+    }
+    1.0 / (1.0 + r * r)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_power_heuristic_never_gives_nan() {
+        assert_eq!(power_heuristic(1.0, 1.0), 0.5);
+        assert!((power_heuristic(3.0, 1.0) - 0.9).abs() < 1e-6);
+        assert_eq!(power_heuristic(0.0, 1.0), 0.0);
+        assert_eq!(power_heuristic(0.0, 0.0), 0.0);
+        assert_eq!(power_heuristic(2.0, 0.0), 1.0);
+        // Densities whose squares overflow f32 (the naive form gives inf / inf).
+        assert_eq!(power_heuristic(4.9e19, 5.8e-9), 1.0);
+        assert!(power_heuristic(5.8e-9, 4.9e19) < 1e-30);
+        assert!((power_heuristic(3e20, 1e20) - 0.9).abs() < 1e-6);
+        assert_eq!(power_heuristic(f32::INFINITY, f32::INFINITY), 0.5);
+        assert_eq!(power_heuristic(f32::INFINITY, 1.0), 1.0);
+        assert_eq!(power_heuristic(f32::NAN, 1.0), 0.0);
+    }
 
     #[test]
     fn points_are_chosen_in_proportion_to_area() {
