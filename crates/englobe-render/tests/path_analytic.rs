@@ -222,3 +222,58 @@ fn the_path_tracer_converges_as_one_over_the_sample_count() {
     eprintln!("log-log slope of the MSE: {slope:.3}");
     assert!((-1.15..=-0.85).contains(&slope), "log-log slope {slope}: {points:?}");
 }
+
+#[test]
+fn in_a_white_furnace_every_object_vanishes() {
+    // Under a uniform sky of radiance 1, objects that absorb nothing (white diffuse, a perfect
+    // mirror, clear glass) return every path's light: each pixel is 1, whatever the material.
+    // Paths that reach the maximum depth before escaping lose their light, so the mean may fall
+    // short by that alone; energy is never created.
+    let s = scene(
+        r#"
+[image]
+width = 24
+height = 24
+samples = 16
+max_depth = 64
+integrator = "path"
+background = [1.0, 1.0, 1.0]
+[camera]
+position = [0, 0.5, -4]
+look_at = [0, 0.3, 0]
+fov = 50
+[materials.white]
+diffuse = [1.0, 1.0, 1.0]
+[materials.mirror]
+diffuse = [0.0, 0.0, 0.0]
+reflectivity = 1.0
+[materials.glass]
+diffuse = [0.0, 0.0, 0.0]
+transparency = 1.0
+ior = 1.5
+[[sphere]]
+center = [-0.9, 0.5, 0]
+radius = 0.6
+material = "white"
+[[sphere]]
+center = [0.8, 0.5, 0.2]
+radius = 0.6
+material = "glass"
+[[box]]
+min = [-0.4, -0.3, 0.6]
+max = [0.4, 1.2, 1.0]
+material = "mirror"
+[[box]]
+min = [-2.0, -0.6, -1.0]
+max = [2.0, -0.3, 2.0]
+material = "white"
+"#,
+    );
+    let world = build_world(&s, AccelKind::BvhWide).unwrap();
+    let out = Renderer::new(&s, &world).render().unwrap();
+    let values: Vec<f64> = out.film.pixels().iter().flat_map(|p| p.to_array()).map(f64::from).collect();
+    let mean = values.iter().sum::<f64>() / values.len() as f64;
+    let max = values.iter().copied().fold(0.0, f64::max);
+    assert!(max <= 1.0 + 1e-4, "energy created: a pixel of {max}");
+    assert!(mean > 0.995, "mean {mean}: light lost");
+}
