@@ -1,6 +1,7 @@
 //! The integrators against closed forms, with tolerances from the sample counts: Fresnel's
 //! equations at known angles, direct light from a directional and a point light on a diffuse
-//! plane, the depth-limited furnace, and the path tracer's convergence rate.
+//! plane, the white furnace, and the path tracer's convergence rate (the emissive furnaces are in
+//! `path.rs`).
 //!
 //! Light units are the scene format's (see englobe-render's `shading`): a diffuse surface of
 //! albedo `rho` lit by a point light of intensity `I` at distance `d` and angle `theta` reflects
@@ -92,43 +93,6 @@ fn direct_light_on_a_diffuse_plane_matches_the_closed_forms() {
                 "{integrator}, h {h}, x {x}: {got} against {expected}"
             );
         }
-    }
-}
-
-/// Twelve triangles making a closed cube around the camera, facing inward, emitting `le` and
-/// reflecting `rho`, with the given depth and samples.
-fn furnace(le: f32, rho: f32, depth: u32, samples: u32) -> Scene {
-    let c = [[-1, -1, -1], [1, -1, -1], [1, 1, -1], [-1, 1, -1], [-1, -1, 1], [1, -1, 1], [1, 1, 1], [-1, 1, 1]];
-    let faces = [[0, 1, 2, 3], [5, 4, 7, 6], [4, 0, 3, 7], [1, 5, 6, 2], [4, 5, 1, 0], [3, 2, 6, 7]];
-    let mut text = format!(
-        "[image]\nwidth = 16\nheight = 16\nsamples = {samples}\nmax_depth = {depth}\nintegrator = \"path\"\n\
-         [camera]\nposition = [0.1, 0.2, -0.3]\nlook_at = [0.3, -0.1, 1]\nfov = 100\n\
-         [materials.wall]\ndiffuse = [{rho}, {rho}, {rho}]\nemission = [{le}, {le}, {le}]\n"
-    );
-    let v = |i: usize| format!("[{}, {}, {}]", c[i][0], c[i][1], c[i][2]);
-    for f in faces {
-        for tri in [[f[0], f[1], f[2]], [f[0], f[2], f[3]]] {
-            text += &format!(
-                "[[triangle]]\nvertices = [{}, {}, {}]\nmaterial = \"wall\"\n",
-                v(tri[0]),
-                v(tri[1]),
-                v(tri[2])
-            );
-        }
-    }
-    scene(&text)
-}
-
-#[test]
-fn the_depth_limited_furnace_sums_the_bounces_it_keeps() {
-    // Seen through D bounces, the walls give Le (1 + rho + ... + rho^D) = Le (1 - rho^(D+1)) / (1 - rho).
-    let (le, rho) = (0.1, 0.5);
-    for depth in [0u32, 1, 2, 4] {
-        let got = mean_red(&furnace(le, rho, depth, 32), IntegratorKind::Path);
-        let expected = le as f64 * (1.0 - (rho as f64).powi(depth as i32 + 1)) / (1.0 - rho as f64);
-        // 8192 paths whose value lies between Le and Le / (1 - rho): a standard error under 0.5 %
-        // of the mean; 2 % is four of them.
-        assert!((got - expected).abs() < 0.02 * expected, "depth {depth}: {got} against {expected}");
     }
 }
 

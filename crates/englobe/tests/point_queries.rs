@@ -7,6 +7,7 @@ mod common;
 
 use common::load_obj;
 use common::rng::{in_box, seeded};
+use common::strategies::{point, triangle};
 use englobe::shapes::{closest_point_on_triangle, distance_squared, is_degenerate, triangle_overlaps_box};
 use englobe::{Aabb, AccelKind, ClosestPoint, Object, TriangleBvh, TriangleMesh, Vec3, World};
 use proptest::prelude::*;
@@ -58,23 +59,6 @@ fn check(tris: &[[Vec3; 3]], points: &[(Vec3, f32)], boxes: &[Aabb]) -> Result<(
         found.1 += expected.len();
     }
     Ok(found)
-}
-
-fn coord() -> impl Strategy<Value = f32> {
-    prop_oneof![3 => -4.0f32..4.0, 1 => (-4i32..=4).prop_map(|i| i as f32)]
-}
-
-fn point() -> impl Strategy<Value = Vec3> {
-    (coord(), coord(), coord()).prop_map(|(x, y, z)| Vec3::new(x, y, z))
-}
-
-/// Small triangles, and degenerate ones: a repeated vertex, or three points on a line.
-fn triangle() -> impl Strategy<Value = [Vec3; 3]> {
-    prop_oneof![
-        8 => (point(), point(), point()).prop_map(|(a, b, c)| [a, a + (b - a) * 0.4, a + (c - a) * 0.4]),
-        1 => (point(), point()).prop_map(|(a, b)| [a, b, a]),
-        1 => (point(), point()).prop_map(|(a, b)| [a, b, a + (b - a) * 2.0]),
-    ]
 }
 
 /// Points anywhere (some on the grid of integer vertices), with a radius or none.

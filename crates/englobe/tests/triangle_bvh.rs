@@ -8,6 +8,7 @@ mod common;
 
 use common::load_obj;
 use common::rng::{in_box, in_cube, ray_into_box, seeded};
+use common::strategies::{point, triangle};
 use englobe::accel::wide::Isa;
 use englobe::shapes::{WatertightRay, intersect_triangle};
 use englobe::{Hit, NoCount, Ray, TriangleBvh, Vec3, WorkCounts};
@@ -53,23 +54,6 @@ fn check(tris: &[[Vec3; 3]], rays: &[Ray]) -> Result<usize, String> {
         }
     }
     Ok(expected.iter().filter(|e| e.0.is_some()).count())
-}
-
-fn coord() -> impl Strategy<Value = f32> {
-    prop_oneof![3 => -4.0f32..4.0, 1 => (-4i32..=4).prop_map(|i| i as f32)]
-}
-
-fn point() -> impl Strategy<Value = Vec3> {
-    (coord(), coord(), coord()).prop_map(|(x, y, z)| Vec3::new(x, y, z))
-}
-
-/// Small triangles, and degenerate ones: a repeated vertex, or three points on a line.
-fn triangle() -> impl Strategy<Value = [Vec3; 3]> {
-    prop_oneof![
-        8 => (point(), point(), point()).prop_map(|(a, b, c)| [a, a + (b - a) * 0.4, a + (c - a) * 0.4]),
-        1 => (point(), point()).prop_map(|(a, b)| [a, b, a]),
-        1 => (point(), point()).prop_map(|(a, b)| [a, b, a + (b - a) * 2.0]),
-    ]
 }
 
 /// Directions: random, or along an axis with zeros of either sign.

@@ -1,11 +1,12 @@
 //! Shared by the cross-structure tests: one check that runs every structure of
 //! [`AccelKind::ALL`] against brute force (the kd-tree both with the caller's clipping and with
-//! plain boxes), the shared data folder and its meshes, and (in [`rng`]) the tests' random
-//! numbers.
+//! plain boxes), the shared data folder and its meshes, (in [`rng`]) the tests' random
+//! numbers and (in [`strategies`]) the proptest strategies several tests share.
 
 #![allow(dead_code)]
 
 pub mod rng;
+pub mod strategies;
 
 use std::path::PathBuf;
 
