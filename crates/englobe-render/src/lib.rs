@@ -28,6 +28,7 @@ pub mod render;
 pub mod sampling;
 pub mod shading;
 pub mod stats;
+pub mod supersample;
 pub mod tile;
 pub mod whitted;
 
