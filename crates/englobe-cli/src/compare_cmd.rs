@@ -9,19 +9,30 @@ use clap::Args;
 use englobe::AccelKind;
 use englobe_lab::{CompareOptions, run_compare};
 
-use crate::image_options::parse_accel;
+use englobe_scene::Override;
+
+use crate::image_options::{image_size, parse_accel, parse_scale};
 use crate::render_cmd::read_scene;
 
 #[derive(Args)]
 pub struct CompareArgs {
     /// Scene file (TOML, see docs/scene-format.md); the embedded default scene if omitted.
     scene: Option<PathBuf>,
-    /// Image width in pixels (overrides the scene).
+    /// Set any value of the scene by its dotted path, as a TOML value (repeatable), as in
+    /// `englobe render`: `-D camera.fov=40`.
+    #[arg(short = 'D', long = "set", value_name = "KEY=VALUE")]
+    set: Vec<Override>,
+    /// Image width in pixels (overrides the scene; alone, the height follows the scene's aspect
+    /// ratio).
     #[arg(long)]
     width: Option<u32>,
-    /// Image height in pixels (overrides the scene).
+    /// Image height in pixels (overrides the scene; alone, the width follows the scene's aspect
+    /// ratio).
     #[arg(long)]
     height: Option<u32>,
+    /// Scale the image size by this factor, after --width and --height.
+    #[arg(long, value_parser = parse_scale)]
+    scale: Option<f64>,
     /// Samples per pixel (overrides the scene).
     #[arg(long)]
     spp: Option<u32>,
@@ -50,10 +61,11 @@ pub struct CompareArgs {
 }
 
 pub fn run(args: CompareArgs) -> anyhow::Result<ExitCode> {
-    let (scene, scene_name) = read_scene(args.scene.as_ref())?;
+    let (scene, scene_name) = read_scene(args.scene.as_ref(), &args.set)?;
+    let (width, height) = image_size(&scene.image, args.width, args.height, args.scale);
     let options = CompareOptions {
-        width: args.width,
-        height: args.height,
+        width: Some(width),
+        height: Some(height),
         spp: args.spp,
         accel: args.accel,
         threads: args.threads,

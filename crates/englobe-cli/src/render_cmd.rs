@@ -1,6 +1,7 @@
 //! `englobe render`: one scene to one image, with optional statistics, or one piece of an image
 //! (`--tile K/N`, `--pixel-bounds`) written as an OpenEXR tile for `englobe assemble`.
 
+use std::io::Read;
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
@@ -11,7 +12,7 @@ use englobe_lab::memory::peak_rss_bytes;
 use englobe_lab::report::{StatsReport, stats_table, write_json};
 use englobe_render::tile::file::{TileHeader, VERSION, write_tile};
 use englobe_render::{HeatmapScale, PixelWindow, Renderer, TileSpec, build_world, write_cost_image, write_image};
-use englobe_scene::{Scene, load_scene, parse_scene};
+use englobe_scene::{Override, Scene, load_scene_with, parse_scene_with};
 
 use crate::image_options::{ImageOptions, render_digest};
 use crate::interrupt;
@@ -19,7 +20,8 @@ use crate::progress::tile_bar;
 
 #[derive(Args)]
 pub struct RenderArgs {
-    /// Scene file (TOML, see docs/scene-format.md); the embedded default scene if omitted.
+    /// Scene file (TOML, see docs/scene-format.md), `-` for standard input; the embedded default
+    /// scene if omitted.
     scene: Option<PathBuf>,
     /// Output image (.png or .exr); defaults to the scene's name with .png, in the current folder
     /// (with --tile or --pixel-bounds: an .exr tile, named after the scene and the tile).
@@ -77,23 +79,49 @@ pub enum CostScale {
     Linear,
 }
 
-/// The scene of the command line, or the embedded default, with its display name.
-pub fn read_scene(path: Option<&PathBuf>) -> anyhow::Result<(Scene, String)> {
+/// The scene of the command line (`-` reads it from standard input), or the embedded default,
+/// with `overrides` applied, and its display name.
+pub fn read_scene(path: Option<&PathBuf>, overrides: &[Override]) -> anyhow::Result<(Scene, String)> {
     match path {
-        Some(p) => Ok((load_scene(p)?, p.display().to_string())),
-        None => Ok((parse_scene(englobe_render::DEFAULT_SCENE, "default.toml".as_ref())?, "default".to_owned())),
+        Some(p) if p.as_os_str() == "-" => {
+            let text = read_stdin()?;
+            Ok((parse_scene_with(&text, STDIN_NAME.as_ref(), overrides)?, STDIN_NAME.to_owned()))
+        }
+        Some(p) => Ok((load_scene_with(p, overrides)?, p.display().to_string())),
+        None => Ok((
+            parse_scene_with(englobe_render::DEFAULT_SCENE, "default.toml".as_ref(), overrides)?,
+            "default".to_owned(),
+        )),
     }
+}
+
+/// How a scene read from standard input is named in messages; its mesh paths are relative to the
+/// current folder.
+const STDIN_NAME: &str = "<stdin>";
+
+fn read_stdin() -> anyhow::Result<String> {
+    let limit = englobe_scene::parse::MAX_SCENE_BYTES;
+    let mut bytes = Vec::new();
+    std::io::stdin()
+        .lock()
+        .take(limit + 1)
+        .read_to_end(&mut bytes)
+        .with_context(|| format!("{STDIN_NAME}: cannot read the scene"))?;
+    anyhow::ensure!(bytes.len() as u64 <= limit, "{STDIN_NAME}: the scene is larger than the {limit}-byte limit");
+    String::from_utf8(bytes).map_err(|e| {
+        anyhow::anyhow!("{STDIN_NAME}: byte {}: the scene is not valid UTF-8", e.utf8_error().valid_up_to())
+    })
 }
 
 pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
     let interrupted = interrupt::install()?;
-    let (mut scene, scene_name) = read_scene(args.scene.as_ref())?;
+    let (mut scene, scene_name) = read_scene(args.scene.as_ref(), &args.image.set)?;
     if !args.quiet {
         for w in &scene.warnings {
             eprintln!("warning: {w}");
         }
     }
-    args.image.apply(&mut scene);
+    args.image.apply(&mut scene)?;
     let accel = args.image.accel;
     let (width, height, samples, integrator) =
         (scene.image.width, scene.image.height, scene.image.samples, scene.image.integrator);
@@ -105,8 +133,12 @@ pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
         }
         (None, None) => None,
     };
-    let stem =
-        args.scene.as_ref().and_then(|p| p.file_stem()).map_or("englobe".into(), |s| s.to_string_lossy().into_owned());
+    let stem = args
+        .scene
+        .as_ref()
+        .filter(|p| p.as_os_str() != "-")
+        .and_then(|p| p.file_stem())
+        .map_or("englobe".into(), |s| s.to_string_lossy().into_owned());
     let output = args.output.clone().unwrap_or_else(|| match piece {
         Some((_, Some(tile))) => PathBuf::from(format!("{stem}.tile-{}-of-{}.exr", tile.index, tile.count)),
         Some((w, None)) => PathBuf::from(format!("{stem}.window-{}-{}-{}-{}.exr", w.x0, w.x1, w.y0, w.y1)),
