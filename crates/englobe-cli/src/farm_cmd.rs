@@ -288,7 +288,7 @@ fn write_script(path: &Path, args: &SlurmArgs, plan: &Plan, dir: &Path) -> anyho
         render = render.join(" "),
     );
     englobe_render::output::write_atomically(path, |w| {
-        w.write_all(text.as_bytes()).map_err(|source| englobe_render::OutputError::Io { path: path.to_owned(), source })
+        w.write_all(text.as_bytes()).map_err(|error| englobe_render::OutputError::Io { path: path.to_owned(), error })
     })?;
     Ok(())
 }

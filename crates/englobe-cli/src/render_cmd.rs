@@ -115,6 +115,32 @@ fn read_stdin() -> anyhow::Result<String> {
 
 pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
     let interrupted = interrupt::install()?;
+    // The destination is checked first, before the scene and its meshes are read: a long render
+    // must not end in "cannot write".
+    let stem = args
+        .scene
+        .as_ref()
+        .filter(|p| p.as_os_str() != "-")
+        .and_then(|p| p.file_stem())
+        .map_or("englobe".into(), |s| s.to_string_lossy().into_owned());
+    let output = args.output.clone().unwrap_or_else(|| match (args.tile, args.pixel_bounds) {
+        (Some(tile), _) => PathBuf::from(format!("{stem}.tile-{}-of-{}.exr", tile.index, tile.count)),
+        (None, Some(w)) => PathBuf::from(format!("{stem}.window-{}-{}-{}-{}.exr", w.x0, w.x1, w.y0, w.y1)),
+        (None, None) => PathBuf::from(stem).with_extension("png"),
+    });
+    let format = englobe_render::output::check_writable(&output)?;
+    if args.tile.is_some() || args.pixel_bounds.is_some() {
+        anyhow::ensure!(
+            format == englobe_render::OutputFormat::Exr,
+            "{}: a tile is written as OpenEXR (.exr), so that `englobe assemble` gets the exact values",
+            output.display()
+        );
+        anyhow::ensure!(
+            args.aov == Aov::Color,
+            "--aov cost cannot be tiled: its colour scale depends on the whole image"
+        );
+    }
+
     let (mut scene, scene_name) = read_scene(args.scene.as_ref(), &args.image.set)?;
     if !args.quiet {
         for w in &scene.warnings {
@@ -133,29 +159,6 @@ pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
         }
         (None, None) => None,
     };
-    let stem = args
-        .scene
-        .as_ref()
-        .filter(|p| p.as_os_str() != "-")
-        .and_then(|p| p.file_stem())
-        .map_or("englobe".into(), |s| s.to_string_lossy().into_owned());
-    let output = args.output.clone().unwrap_or_else(|| match piece {
-        Some((_, Some(tile))) => PathBuf::from(format!("{stem}.tile-{}-of-{}.exr", tile.index, tile.count)),
-        Some((w, None)) => PathBuf::from(format!("{stem}.window-{}-{}-{}-{}.exr", w.x0, w.x1, w.y0, w.y1)),
-        None => PathBuf::from(stem).with_extension("png"),
-    });
-    let format = englobe_render::OutputFormat::from_path(&output)?;
-    if piece.is_some() {
-        anyhow::ensure!(
-            format == englobe_render::OutputFormat::Exr,
-            "{}: a tile is written as OpenEXR (.exr), so that `englobe assemble` gets the exact values",
-            output.display()
-        );
-        anyhow::ensure!(
-            args.aov == Aov::Color,
-            "--aov cost cannot be tiled: its colour scale depends on the whole image"
-        );
-    }
 
     let build_start = Instant::now();
     let world = build_world(&scene, accel).context("cannot build the acceleration structure")?;

@@ -35,13 +35,19 @@ pub fn load_scene_with(path: &Path, overrides: &[Override]) -> Result<Scene, Sce
     if meta.is_dir() {
         return Err(SceneError::io(path, std::io::Error::other("is a directory, expected a scene file")));
     }
+    let too_large = |bytes: String| {
+        SceneError::io(path, std::io::Error::other(format!("{bytes} is larger than the {MAX_SCENE_BYTES}-byte limit")))
+    };
     if meta.len() > MAX_SCENE_BYTES {
-        return Err(SceneError::io(
-            path,
-            std::io::Error::other(format!("{} bytes is larger than the {MAX_SCENE_BYTES}-byte limit", meta.len())),
-        ));
+        return Err(too_large(format!("{} bytes", meta.len())));
     }
-    let bytes = std::fs::read(path).map_err(|e| SceneError::io(path, e))?;
+    // A device or a pipe has no size beforehand: the limit holds while reading.
+    let file = std::fs::File::open(path).map_err(|e| SceneError::io(path, e))?;
+    let bytes = crate::mesh::read_at_most(file, meta.len() as usize, MAX_SCENE_BYTES + 1)
+        .map_err(|e| SceneError::io(path, e))?;
+    if bytes.len() as u64 > MAX_SCENE_BYTES {
+        return Err(too_large("the file".into()));
+    }
     let text = String::from_utf8(bytes).map_err(|e| {
         let at = e.utf8_error().valid_up_to();
         SceneError::at(&path.display().to_string(), "", None, format!("byte {at}: the file is not valid UTF-8"))
