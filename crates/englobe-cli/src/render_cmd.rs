@@ -16,7 +16,7 @@ use englobe_scene::{Override, Scene, load_scene_with, parse_scene_with};
 
 use crate::image_options::{ImageOptions, render_digest};
 use crate::interrupt;
-use crate::progress::tile_bar;
+use crate::progress::{Phases, tile_bar};
 
 #[derive(Args)]
 pub struct RenderArgs {
@@ -114,6 +114,7 @@ fn read_stdin() -> anyhow::Result<String> {
 }
 
 pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
+    let wall = Instant::now();
     let interrupted = interrupt::install()?;
     // The destination is checked first, before the scene and its meshes are read: a long render
     // must not end in "cannot write".
@@ -141,7 +142,18 @@ pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
         );
     }
 
+    let phases = Phases::new(args.quiet);
+    let shown_name = args.scene.as_ref().map_or("the default scene".into(), |p| p.display().to_string());
+    let phase = phases.begin(&format!("loading {shown_name}"));
     let (mut scene, scene_name) = read_scene(args.scene.as_ref(), &args.image.set)?;
+    let load_seconds = phases.end(phase, |s| {
+        let triangles: usize = scene.objects.iter().map(|o| o.object.triangle_count()).sum();
+        format!(
+            "loaded {shown_name} in {s:.2} s: {} objects ({triangles} triangles in the picture), {} lights",
+            scene.objects.len(),
+            scene.lights.len()
+        )
+    });
     if !args.quiet {
         for w in &scene.warnings {
             eprintln!("warning: {w}");
@@ -160,9 +172,10 @@ pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
         (None, None) => None,
     };
 
-    let build_start = Instant::now();
+    let phase = phases.begin(&format!("building {accel}"));
     let world = build_world(&scene, accel).context("cannot build the acceleration structure")?;
-    let build_seconds = build_start.elapsed().as_secs_f64();
+    let build_seconds =
+        phases.end(phase, |s| format!("built {accel} in {s:.2} s over {} triangles", world.triangle_count()));
 
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(args.threads.map_or(0, |t| t as usize))
@@ -187,7 +200,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
     if !out.complete {
         eprintln!(
             "interrupted: stopped after {} of {tiles} tiles; no image written ({} left as it was)",
-            bar.position(),
+            out.tiles_done,
             output.display()
         );
         return Ok(ExitCode::from(interrupt::INTERRUPTED_EXIT_CODE));
@@ -229,12 +242,14 @@ pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
             None => format!("{width}x{height}"),
         };
         println!(
-            "wrote {} ({what}, {samples} spp, {}, accel {}, {:.2} s on {} threads)",
+            "wrote {} ({what}, {samples} spp, {}, accel {}, {:.2} s on {} threads: load {load_seconds:.2} s, \
+             build {build_seconds:.2} s, render {:.2} s)",
             output.display(),
             integrator.name(),
             accel,
+            wall.elapsed().as_secs_f64(),
+            pool.current_num_threads(),
             out.seconds,
-            pool.current_num_threads()
         );
     }
     let peak_memory_bytes = peak_rss_bytes();

@@ -48,6 +48,8 @@ pub struct RenderOutput {
     pub stats: RenderStats,
     /// False if the render was cancelled before every tile was done (missing tiles are black).
     pub complete: bool,
+    /// Tiles of [`TILE_SIZE`] pixels finished, out of all the window's.
+    pub tiles_done: usize,
     /// Wall-clock seconds spent rendering.
     pub seconds: f64,
     /// Work per pixel (nodes visited plus exact tests) over the window, if [`Renderer::record_cost`]
@@ -229,11 +231,13 @@ impl<'a> Renderer<'a> {
         let mut cost = self.record_cost.then(|| CostImage::new(window.width(), window.height()));
         let mut stats = RenderStats::default();
         let mut complete = true;
+        let mut tiles_done = 0;
         for (index, tile) in tiles.into_iter().enumerate() {
             let Some(tile) = tile else {
                 complete = false;
                 continue;
             };
+            tiles_done += 1;
             stats.add(&tile.stats);
             let (x0, y0, x1, y1) = tile_at(index);
             let mut it = tile.pixels.into_iter();
@@ -247,7 +251,7 @@ impl<'a> Renderer<'a> {
                 }
             }
         }
-        RenderOutput { film, window, stats, complete, seconds: start.elapsed().as_secs_f64(), cost }
+        RenderOutput { film, window, stats, complete, tiles_done, seconds: start.elapsed().as_secs_f64(), cost }
     }
 
     fn pixel<C: Counters>(
