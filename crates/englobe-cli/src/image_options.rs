@@ -17,6 +17,15 @@ pub struct ImageOptions {
     /// array such as `[[point_light]]`, one past its end adds an entry, a bare word is a string.
     #[arg(short = 'D', long = "set", value_name = "KEY=VALUE")]
     pub set: Vec<Override>,
+    /// Camera position, as X,Y,Z (the same as -D camera.position=[X,Y,Z]).
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_point, allow_hyphen_values = true)]
+    pub look_from: Option<String>,
+    /// The point the camera looks at, as X,Y,Z (the same as -D camera.look_at=[X,Y,Z]).
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_point, allow_hyphen_values = true)]
+    pub look_at: Option<String>,
+    /// Vertical field of view in degrees (the same as -D camera.fov=DEGREES).
+    #[arg(long, value_name = "DEGREES", value_parser = parse_fov)]
+    pub fov: Option<f32>,
     /// Image width in pixels (overrides the scene; alone, the height follows the scene's aspect
     /// ratio).
     #[arg(long)]
@@ -53,6 +62,19 @@ impl ImageOptions {
             .map_err(anyhow::Error::msg)
     }
 
+    /// The overrides of the scene's document: the camera options, then the `-D` ones (which come
+    /// later, so they win).
+    pub fn overrides(&self) -> Vec<Override> {
+        let camera = [
+            ("camera.position", self.look_from.clone()),
+            ("camera.look_at", self.look_at.clone()),
+            ("camera.fov", self.fov.map(|f| f.to_string())),
+        ];
+        let camera =
+            camera.into_iter().filter_map(|(key, value)| Some(Override { key: key.to_owned(), value: value? }));
+        camera.chain(self.set.iter().cloned()).collect()
+    }
+
     /// The same options as command-line arguments, to pass them on to another `englobe render`.
     pub fn to_args(&self) -> Vec<String> {
         let mut args = vec!["--accel".to_owned(), self.accel.name().to_owned()];
@@ -64,6 +86,9 @@ impl ImageOptions {
                 args.extend([flag.to_owned(), v]);
             }
         };
+        push("--look-from", self.look_from.as_ref().map(|p| p.trim_matches(['[', ']']).replace(' ', "")));
+        push("--look-at", self.look_at.as_ref().map(|p| p.trim_matches(['[', ']']).replace(' ', "")));
+        push("--fov", self.fov.map(|v| v.to_string()));
         push("--width", self.width.map(|v| v.to_string()));
         push("--height", self.height.map(|v| v.to_string()));
         push("--scale", self.scale.map(|v| v.to_string()));
@@ -93,6 +118,22 @@ pub fn image_size(image: &ImageSettings, width: Option<u32>, height: Option<u32>
     match scale {
         Some(s) => (pixels(w as f64 * s), pixels(h as f64 * s)),
         None => (w, h),
+    }
+}
+
+fn parse_fov(s: &str) -> Result<f32, String> {
+    match s.parse::<f32>() {
+        Ok(x) if x > 0.0 && x < 180.0 => Ok(x),
+        _ => Err(format!("`{s}`: expected degrees, more than 0 and less than 180")),
+    }
+}
+
+/// `X,Y,Z` as the TOML array `[X, Y, Z]`.
+fn parse_point(s: &str) -> Result<String, String> {
+    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+    match parts.iter().map(|p| p.parse::<f32>()).collect::<Result<Vec<f32>, _>>() {
+        Ok(v) if v.len() == 3 && v.iter().all(|x| x.is_finite()) => Ok(format!("[{}]", parts.join(", "))),
+        _ => Err(format!("`{s}`: expected three numbers X,Y,Z, such as 0,1.5,-6")),
     }
 }
 

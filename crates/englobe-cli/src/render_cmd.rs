@@ -145,7 +145,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
     let phases = Phases::new(args.quiet);
     let shown_name = args.scene.as_ref().map_or("the default scene".into(), |p| p.display().to_string());
     let phase = phases.begin(&format!("loading {shown_name}"));
-    let (mut scene, scene_name) = read_scene(args.scene.as_ref(), &args.image.set)?;
+    let (mut scene, scene_name) = read_scene(args.scene.as_ref(), &args.image.overrides())?;
     let load_seconds = phases.end(phase, |s| {
         let triangles: usize = scene.objects.iter().map(|o| o.object.triangle_count()).sum();
         format!(

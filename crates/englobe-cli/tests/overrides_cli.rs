@@ -111,3 +111,30 @@ fn a_scene_is_read_from_standard_input() {
     assert!(!o.status.success());
     assert!(stderr(&o).contains("error: <stdin>:17:7: a field of view of -1 degrees"), "{}", stderr(&o));
 }
+
+#[test]
+fn the_camera_is_set_from_the_command_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = |extra: &[&str], out: &str| {
+        let o = englobe(dir.path(), &[&["render", "--width", "48", "--spp", "2", "-q", "-o", out][..], extra].concat());
+        assert!(o.status.success(), "{}", stderr(&o));
+        std::fs::read(dir.path().join(out)).unwrap()
+    };
+    let flags = run(&["--look-from", "2,3,-6", "--look-at", "0,0.5,0", "--fov", "35"], "flags.png");
+    let set = run(
+        &["-D", "camera.position=[2, 3, -6]", "-D", "camera.look_at=[0, 0.5, 0]", "-D", "camera.fov=35"],
+        "set.png",
+    );
+    assert_eq!(flags, set, "the flags are the overrides");
+    assert_ne!(flags, run(&[], "plain.png"));
+    let ortho = run(&["-D", "camera.projection=orthographic", "-D", "camera.view_height=4"], "ortho.png");
+    let lens = run(&["-D", "camera.aperture=0.3", "-D", "camera.focus_distance=7"], "lens.png");
+    assert_ne!(ortho, run(&[], "plain2.png"));
+    assert_ne!(lens, ortho);
+    let o = englobe(dir.path(), &["render", "--fov", "190"]);
+    assert!(stderr(&o).contains("`190`: expected degrees, more than 0 and less than 180"), "{}", stderr(&o));
+    let o = englobe(dir.path(), &["render", "--look-from", "1,2"]);
+    assert!(stderr(&o).contains("`1,2`: expected three numbers X,Y,Z"), "{}", stderr(&o));
+    let o = englobe(dir.path(), &["render", "--look-from", "0,0.8,0"]);
+    assert!(stderr(&o).contains("the camera's look_at must differ from its position"), "{}", stderr(&o));
+}

@@ -31,7 +31,7 @@ pub mod stats;
 pub mod tile;
 pub mod whitted;
 
-pub use camera::PinholeCamera;
+pub use camera::ImageCamera;
 pub use cost::{CostImage, write_cost_image};
 pub use film::Film;
 pub use heatmap::{Heatmap, HeatmapScale};

@@ -18,7 +18,7 @@ use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg32;
 use rayon::prelude::*;
 
-use crate::camera::PinholeCamera;
+use crate::camera::ImageCamera;
 use crate::cost::CostImage;
 use crate::film::Film;
 use crate::path::PathTracer;
@@ -171,7 +171,7 @@ impl<'a> Renderer<'a> {
 
     fn render_with<C: Counters + Copy + Send + Into<WorkCounts>>(&self) -> RenderOutput {
         let start = Instant::now();
-        let camera = PinholeCamera::new(&self.scene.camera, self.width, self.height);
+        let camera = ImageCamera::new(&self.scene.camera, self.width, self.height);
         let integrator = match self.integrator {
             IntegratorKind::Whitted => Integrator::Whitted(Whitted::new(self.scene, self.world)),
             IntegratorKind::Path => Integrator::Path(PathTracer::new(self.scene, self.world)),
@@ -256,7 +256,7 @@ impl<'a> Renderer<'a> {
 
     fn pixel<C: Counters>(
         &self,
-        camera: &PinholeCamera,
+        camera: &ImageCamera,
         integrator: &Integrator,
         x: u32,
         y: u32,
@@ -264,7 +264,13 @@ impl<'a> Renderer<'a> {
     ) -> Vec3 {
         let mut rng = pixel_rng(self.scene.image.seed, x, y);
         let mut sample = |rng: &mut Pcg32, dx: f32, dy: f32| {
-            let ray = camera.ray(x as f32 + dx, y as f32 + dy);
+            let ray = if camera.has_lens() {
+                // Drawn only with a lens, so that pinhole images keep their random numbers.
+                let (u, v): (f32, f32) = (rng.random(), rng.random());
+                camera.ray_through_lens(x as f32 + dx, y as f32 + dy, u, v)
+            } else {
+                camera.ray(x as f32 + dx, y as f32 + dy)
+            };
             match integrator {
                 Integrator::Whitted(w) => w.radiance(&ray, RayKind::Primary, 0, tally),
                 Integrator::Path(p) => p.radiance(&ray, rng, tally),

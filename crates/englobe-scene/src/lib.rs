@@ -18,8 +18,8 @@ pub mod shared_data;
 
 pub use error::{Located, SceneError};
 pub use model::{
-    Camera, ImageSettings, IntegratorKind, Light, MAX_DEPTH, MAX_PIXELS, MAX_SAMPLES, Material, MaterialId, Scene,
-    SceneObject,
+    Camera, ImageSettings, IntegratorKind, Light, MAX_DEPTH, MAX_PIXELS, MAX_SAMPLES, Material, MaterialId, Projection,
+    Scene, SceneObject,
 };
 pub use overrides::Override;
 pub use parse::{DEFAULT_MATERIAL, load_scene, load_scene_with, parse_scene, parse_scene_with};

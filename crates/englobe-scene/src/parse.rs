@@ -12,8 +12,8 @@ use toml::Spanned;
 use toml::de::DeTable;
 
 use crate::error::{Located, SceneError};
-use crate::format::{CameraDef, ImageDef, MaterialDef, SceneFile};
-use crate::model::{Camera, ImageSettings, Light, Material, MaterialId, Scene, SceneObject};
+use crate::format::{CameraDef, ImageDef, MaterialDef, ProjectionKind, SceneFile};
+use crate::model::{Camera, ImageSettings, Light, Material, MaterialId, Projection, Scene, SceneObject};
 use crate::overrides::{Override, Placed};
 
 /// Name of the material objects get when they name none.
@@ -235,7 +235,28 @@ impl Converter<'_> {
             Some(f) => f.get_ref().0,
             None => 45.0,
         };
-        Ok(Camera { position, look_at, up, fov_degrees })
+        let distance = view.length();
+        let projection = match (c.projection, &c.view_height) {
+            (ProjectionKind::Perspective, Some(h)) => {
+                return Err(self.err(h.span(), "`view_height` is for `projection = \"orthographic\"`"));
+            }
+            (ProjectionKind::Perspective, None) => Projection::Perspective,
+            (ProjectionKind::Orthographic, h) => Projection::Orthographic {
+                // By default, the size the perspective view has at the look-at point.
+                view_height: h
+                    .as_ref()
+                    .map_or(2.0 * distance * (fov_degrees.to_radians() * 0.5).tan(), |h| h.get_ref().0),
+            },
+        };
+        Ok(Camera {
+            position,
+            look_at,
+            up,
+            fov_degrees,
+            projection,
+            lens_radius: c.aperture.map_or(0.0, |a| a.0 * 0.5),
+            focus_distance: c.focus_distance.map_or(distance, |f| f.0),
+        })
     }
 
     fn materials(
