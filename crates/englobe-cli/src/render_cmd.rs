@@ -12,16 +12,19 @@ use englobe_lab::memory::peak_rss_bytes;
 use englobe_lab::report::{StatsReport, stats_table, write_json};
 use englobe_render::tile::file::{TileHeader, VERSION, write_tile};
 use englobe_render::{HeatmapScale, PixelWindow, Renderer, TileSpec, build_world, write_cost_image, write_image};
+use englobe_scene::framing::{framing_scene, turntable_position};
+use englobe_scene::mesh::MeshFormat;
 use englobe_scene::{Override, Scene, load_scene_with, parse_scene_with};
 
 use crate::image_options::{ImageOptions, render_digest};
 use crate::interrupt;
 use crate::progress::{Phases, tile_bar};
 
-#[derive(Args)]
+#[derive(Args, Clone)]
 pub struct RenderArgs {
-    /// Scene file (TOML, see docs/scene-format.md), `-` for standard input; the embedded default
-    /// scene if omitted.
+    /// Scene file (TOML, see docs/scene-format.md), `-` for standard input, or a mesh file (.obj,
+    /// .ply, .gltf, .glb) to see it framed (camera, ground, lights: the scene `englobe scene MESH`
+    /// prints); the embedded default scene if omitted.
     scene: Option<PathBuf>,
     /// Output image (.png or .exr); defaults to the scene's name with .png, in the current folder
     /// (with --tile or --pixel-bounds: an .exr tile, named after the scene and the tile).
@@ -56,6 +59,11 @@ pub struct RenderArgs {
     /// Write the statistics as JSON to this file.
     #[arg(long, value_name = "FILE")]
     stats_json: Option<PathBuf>,
+    /// Render N frames with the camera turning once around the vertical axis through the point
+    /// it looks at, written as OUT-000.png, OUT-001.png...
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=10000),
+          conflicts_with_all = ["tile", "pixel_bounds"])]
+    turntable: Option<u32>,
     /// No progress bar and no summary line.
     #[arg(short, long)]
     quiet: bool,
@@ -79,10 +87,18 @@ pub enum CostScale {
     Linear,
 }
 
-/// The scene of the command line (`-` reads it from standard input), or the embedded default,
-/// with `overrides` applied, and its display name.
+/// The scene of the command line (`-` reads it from standard input, a mesh file is framed, see
+/// `englobe_scene::framing`), or the embedded default, with `overrides` applied, and its display
+/// name.
 pub fn read_scene(path: Option<&PathBuf>, overrides: &[Override]) -> anyhow::Result<(Scene, String)> {
     match path {
+        Some(p) if MeshFormat::from_path(p).is_some() => {
+            let text = framing_scene(p)?;
+            // Named without a folder, so that the mesh path in the text, as given, is read from
+            // the current folder, as it will be from a scene printed by `englobe scene` there.
+            let name = format!("{} (framed)", p.file_name().unwrap_or(p.as_os_str()).to_string_lossy());
+            Ok((parse_scene_with(&text, name.as_ref(), overrides)?, p.display().to_string()))
+        }
         Some(p) if p.as_os_str() == "-" => {
             let text = read_stdin()?;
             Ok((parse_scene_with(&text, STDIN_NAME.as_ref(), overrides)?, STDIN_NAME.to_owned()))
@@ -114,16 +130,43 @@ fn read_stdin() -> anyhow::Result<String> {
 }
 
 pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
-    let wall = Instant::now();
     let interrupted = interrupt::install()?;
-    // The destination is checked first, before the scene and its meshes are read: a long render
-    // must not end in "cannot write".
-    let stem = args
-        .scene
+    let Some(frames) = args.turntable else { return render(&args, interrupted) };
+    // The camera of the scene as it will be rendered, then one render per frame with its position.
+    let (scene, _) = read_scene(args.scene.as_ref(), &args.image.overrides())?;
+    let (position, look_at) = (scene.camera.position, scene.camera.look_at);
+    let output = args.output.clone().unwrap_or_else(|| PathBuf::from(format!("{}.png", scene_stem(&args))));
+    let stem = output.with_extension("");
+    let ext = output.extension().map_or("png".into(), |e| e.to_string_lossy().into_owned());
+    for k in 0..frames {
+        let p = turntable_position(position, look_at, k, frames);
+        let mut frame = args.clone();
+        frame.turntable = None;
+        frame.output = Some(PathBuf::from(format!("{}-{k:03}.{ext}", stem.display())));
+        frame.image.set.push(Override { key: "camera.position".into(), value: format!("[{}, {}, {}]", p.x, p.y, p.z) });
+        let code = render(&frame, interrupted)?;
+        if code != ExitCode::SUCCESS {
+            return Ok(code);
+        }
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// The scene's file name without its extension, or `englobe` for the default scene and standard
+/// input: what output files are named after.
+fn scene_stem(args: &RenderArgs) -> String {
+    args.scene
         .as_ref()
         .filter(|p| p.as_os_str() != "-")
         .and_then(|p| p.file_stem())
-        .map_or("englobe".into(), |s| s.to_string_lossy().into_owned());
+        .map_or("englobe".into(), |s| s.to_string_lossy().into_owned())
+}
+
+fn render(args: &RenderArgs, interrupted: &'static std::sync::atomic::AtomicBool) -> anyhow::Result<ExitCode> {
+    let wall = Instant::now();
+    // The destination is checked first, before the scene and its meshes are read: a long render
+    // must not end in "cannot write".
+    let stem = scene_stem(args);
     let output = args.output.clone().unwrap_or_else(|| match (args.tile, args.pixel_bounds) {
         (Some(tile), _) => PathBuf::from(format!("{stem}.tile-{}-of-{}.exr", tile.index, tile.count)),
         (None, Some(w)) => PathBuf::from(format!("{stem}.window-{}-{}-{}-{}.exr", w.x0, w.x1, w.y0, w.y1)),

@@ -7,6 +7,7 @@
 
 pub mod error;
 pub mod format;
+pub mod framing;
 pub mod mesh;
 pub mod model;
 pub mod numbers;
