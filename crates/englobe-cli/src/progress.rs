@@ -10,14 +10,20 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 /// A bar counting tiles, hidden when standard error is not a terminal or `quiet` is set.
 pub fn tile_bar(total: usize, quiet: bool) -> ProgressBar {
+    progress_bar(total, "tiles", quiet)
+}
+
+/// A bar counting `unit`s (tiles, passes), hidden when standard error is not a terminal or
+/// `quiet` is set.
+pub fn progress_bar(total: usize, unit: &str, quiet: bool) -> ProgressBar {
     let bar = ProgressBar::new(total as u64);
     if quiet || !std::io::stderr().is_terminal() {
         bar.set_draw_target(ProgressDrawTarget::hidden());
     }
     bar.set_style(
-        ProgressStyle::with_template(
-            "{spinner} rendering [{bar:40}] {percent:>3}% {pos}/{len} tiles, {elapsed} (eta {eta})",
-        )
+        ProgressStyle::with_template(&format!(
+            "{{spinner}} rendering [{{bar:40}}] {{percent:>3}}% {{pos}}/{{len}} {unit}, {{elapsed}} (eta {{eta}})"
+        ))
         .expect("the template is valid")
         .progress_chars("=> "),
     );

@@ -4,7 +4,7 @@
 use std::io::Read;
 use std::path::PathBuf;
 use std::process::ExitCode;
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use anyhow::Context;
 use clap::{Args, ValueEnum};
@@ -18,7 +18,7 @@ use englobe_scene::{Override, Scene, load_scene_with, parse_scene_with};
 
 use crate::image_options::{ImageOptions, render_digest};
 use crate::interrupt;
-use crate::progress::{Phases, tile_bar};
+use crate::progress::{Phases, progress_bar, tile_bar};
 
 #[derive(Args, Clone)]
 pub struct RenderArgs {
@@ -59,6 +59,17 @@ pub struct RenderArgs {
     /// Write the statistics as JSON to this file.
     #[arg(long, value_name = "FILE")]
     stats_json: Option<PathBuf>,
+    /// Stop at the last complete sample pass once this much time has passed since the command
+    /// started (30s, 2m, 1.5h; a bare number is seconds) and write that image, saying so. Renders
+    /// pass by pass (every pixel's first sample, then every pixel's second...), which gives the
+    /// same image when it finishes.
+    #[arg(long, value_name = "DURATION", value_parser = parse_duration,
+          conflicts_with_all = ["tile", "pixel_bounds"])]
+    time_limit: Option<Duration>,
+    /// On Ctrl-C, write the image of the sample passes completed (instead of nothing), saying so;
+    /// renders pass by pass as --time-limit does.
+    #[arg(long, conflicts_with_all = ["tile", "pixel_bounds"])]
+    keep_partial: bool,
     /// Render N frames with the camera turning once around the vertical axis through the point
     /// it looks at, written as OUT-000.png, OUT-001.png...
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=10000),
@@ -185,6 +196,10 @@ fn render(args: &RenderArgs, interrupted: &'static std::sync::atomic::AtomicBool
         );
     }
 
+    anyhow::ensure!(
+        args.aov == Aov::Color || (args.time_limit.is_none() && !args.keep_partial),
+        "--aov cost is not rendered by passes, so it cannot take --time-limit or --keep-partial"
+    );
     let phases = Phases::new(args.quiet);
     let shown_name = args.scene.as_ref().map_or("the default scene".into(), |p| p.display().to_string());
     let phase = phases.begin(&format!("loading {shown_name}"));
@@ -228,19 +243,23 @@ fn render(args: &RenderArgs, interrupted: &'static std::sync::atomic::AtomicBool
     let window = piece.map_or(PixelWindow::full(width, height), |(w, _)| w);
     let tiles = window.width().div_ceil(englobe_render::render::TILE_SIZE) as usize
         * window.height().div_ceil(englobe_render::render::TILE_SIZE) as usize;
-    let bar = tile_bar(tiles, args.quiet);
+    let by_passes = args.time_limit.is_some() || args.keep_partial;
+    let bar =
+        if by_passes { progress_bar(samples as usize, "passes", args.quiet) } else { tile_bar(tiles, args.quiet) };
     let progress = |done: usize, _total: usize| bar.set_position(done as u64);
     let out = pool.install(|| {
-        Renderer::new(&scene, &world)
+        let renderer = Renderer::new(&scene, &world)
             .window(window)
             .count_work(count_work)
             .record_cost(args.aov == Aov::Cost)
             .on_progress(&progress)
-            .cancel_flag(interrupted)
-            .render()
+            .cancel_flag(interrupted);
+        if by_passes { renderer.render_passes(args.time_limit.map(|t| wall + t)) } else { renderer.render() }
     })?;
     bar.finish_and_clear();
-    if !out.complete {
+    let ctrl_c = interrupted.load(std::sync::atomic::Ordering::Relaxed);
+    let mut exit = ExitCode::SUCCESS;
+    if !out.complete && !by_passes {
         eprintln!(
             "interrupted: stopped after {} of {tiles} tiles; no image written ({} left as it was)",
             out.tiles_done,
@@ -248,6 +267,27 @@ fn render(args: &RenderArgs, interrupted: &'static std::sync::atomic::AtomicBool
         );
         return Ok(ExitCode::from(interrupt::INTERRUPTED_EXIT_CODE));
     }
+    if !out.complete {
+        let done = out.samples_done;
+        let why = if ctrl_c {
+            "interrupted".to_owned()
+        } else {
+            format!("time limit of {} reached", show_duration(args.time_limit.unwrap_or_default()))
+        };
+        if done == 0 || (ctrl_c && !args.keep_partial) {
+            eprintln!(
+                "{why}: stopped after {done} of {samples} sample passes; no image written ({} left as it was)",
+                output.display()
+            );
+            let code = if ctrl_c { interrupt::INTERRUPTED_EXIT_CODE } else { 1 };
+            return Ok(ExitCode::from(code));
+        }
+        eprintln!("{why}: stopped after {done} of {samples} sample passes; writing the image of the {done} complete");
+        if ctrl_c {
+            exit = ExitCode::from(interrupt::INTERRUPTED_EXIT_CODE);
+        }
+    }
+    let samples = out.samples_done;
 
     if let Some((window, tile)) = piece {
         let header = TileHeader {
@@ -319,5 +359,29 @@ fn render(args: &RenderArgs, interrupted: &'static std::sync::atomic::AtomicBool
         };
         write_json(path, &report)?;
     }
-    Ok(ExitCode::SUCCESS)
+    Ok(exit)
+}
+
+/// A duration such as `30s`, `2m`, `1.5h` or `90` (seconds).
+fn parse_duration(s: &str) -> Result<Duration, String> {
+    let t = s.trim();
+    let (number, unit) = match t.find(|c: char| c.is_ascii_alphabetic()) {
+        Some(at) => t.split_at(at),
+        None => (t, "s"),
+    };
+    let scale = match unit {
+        "ms" => 0.001,
+        "s" => 1.0,
+        "m" | "min" => 60.0,
+        "h" => 3600.0,
+        _ => return Err(format!("`{s}`: unknown unit `{unit}`; expected a duration such as 30s, 2m or 1.5h")),
+    };
+    match number.trim().parse::<f64>() {
+        Ok(x) if x > 0.0 && (x * scale) < 1e9 => Ok(Duration::from_secs_f64(x * scale)),
+        _ => Err(format!("`{s}`: expected a positive duration such as 30s, 2m or 1.5h")),
+    }
+}
+
+fn show_duration(d: Duration) -> String {
+    format!("{} s", d.as_secs_f64())
 }

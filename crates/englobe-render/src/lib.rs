@@ -23,6 +23,7 @@ pub mod film;
 pub mod heatmap;
 pub mod optics;
 pub mod output;
+mod passes;
 pub mod path;
 pub mod render;
 pub mod sampling;
