@@ -169,3 +169,36 @@ fn cost_aov_writes_a_heatmap_with_its_scale() {
     let png = std::fs::read(&heat).unwrap();
     assert_eq!(&png[1..4], b"PNG");
 }
+
+#[test]
+fn a_claim_that_fails_says_why_and_counts_say_whose_and_at_which_size() {
+    let out = englobe()
+        .args([
+            "experiment",
+            "seed",
+            "--size",
+            "16",
+            "--tests",
+            "1,2",
+            "--accel",
+            "bvh-seed,bvh-seed-ordered,bvh-sah",
+            "-q",
+        ])
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        stdout.contains("Absolute counts are ours at 16x16, the size run, and the report's at its 512x512"),
+        "{stdout}"
+    );
+    assert!(stdout.contains("tests 16x16") && stdout.contains("report 512x512"), "{stdout}");
+    let lines: Vec<&str> = stdout.lines().collect();
+    let no: Vec<usize> = (0..lines.len()).filter(|&i| lines[i].trim_start().starts_with("[NO]")).collect();
+    // At this size bvh-sah is not below bvh-seed-ordered on test 1 (1 312 against 1 304).
+    assert!(!no.is_empty(), "{stdout}");
+    for i in no {
+        let why = lines.get(i + 1).copied().unwrap_or_default().trim_start();
+        assert!(why.starts_with("why not: ") && why.len() > 30, "{} is not explained: {why:?}", lines[i]);
+    }
+    assert!(stdout.contains("on test 1 bvh-sah makes 0.6 % more (1 312 against 1 304)"), "{stdout}");
+}
