@@ -7,6 +7,7 @@ use std::process::ExitCode;
 
 use clap::Args;
 use englobe::AccelKind;
+use englobe_lab::html_report::{render_pictures, write_report};
 use englobe_lab::{CompareOptions, run_compare};
 
 use englobe_scene::Override;
@@ -55,6 +56,11 @@ pub struct CompareArgs {
     /// Also draw rays per second and exact tests per ray of every structure into this SVG file.
     #[arg(long, value_name = "FILE.svg")]
     plot: Option<PathBuf>,
+    /// Also write the comparison as one self-contained HTML page, DIR/index.html: the tables, the
+    /// plot, the image and one cost heatmap per structure on one shared scale (no server, no
+    /// network needed to open it).
+    #[arg(long, value_name = "DIR")]
+    report: Option<PathBuf>,
     /// No progress lines on standard error.
     #[arg(short, long)]
     quiet: bool,
@@ -85,6 +91,14 @@ pub fn run(args: CompareArgs) -> anyhow::Result<ExitCode> {
     }
     if let Some(path) = &args.plot {
         comparison.write_plot(path)?;
+    }
+    if let Some(dir) = &args.report {
+        if !quiet {
+            eprintln!("rendering the pictures of the report...");
+        }
+        let pictures = render_pictures(&scene, &comparison)?;
+        let page = write_report(dir, &comparison, &pictures)?;
+        println!("wrote {}", page.display());
     }
     if !comparison.images_equal() {
         eprintln!("error: some structures drew a different image than brute force");

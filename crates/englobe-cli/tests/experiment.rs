@@ -202,3 +202,22 @@ fn a_claim_that_fails_says_why_and_counts_say_whose_and_at_which_size() {
     }
     assert!(stdout.contains("on test 1 bvh-sah makes 0.6 % more (1 312 against 1 304)"), "{stdout}");
 }
+
+#[test]
+fn compare_writes_a_self_contained_report_page() {
+    let dir = tempfile::tempdir().unwrap();
+    let report = dir.path().join("report");
+    let out = englobe()
+        .args(["compare", "--width", "40", "--accel", "bvh-sah,grid", "--full", "-q", "--report"])
+        .arg(&report)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let page_path = report.join("index.html");
+    assert!(String::from_utf8_lossy(&out.stdout).contains(&format!("wrote {}", page_path.display())));
+    let page = std::fs::read_to_string(&page_path).unwrap();
+    assert_eq!(page.matches("<img ").count(), 4, "the image and a heatmap for none, bvh-sah and grid");
+    assert_eq!(page.matches("src=\"data:image/png;base64,").count(), 4, "every picture inside the page");
+    assert!(page.contains("<svg") && page.contains("<table id=\"quality\">"));
+    assert!(std::fs::read_dir(&report).unwrap().count() == 1, "one file: the page holds everything");
+}

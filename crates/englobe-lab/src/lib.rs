@@ -3,7 +3,8 @@
 //! englobe's research, as a library: the seed report's experiment ([`seed_experiment`], on the
 //! scenes and figures of [`seed_report`]) and the comparison of every acceleration structure on one
 //! scene ([`compare`]), both built on [`measure`] (build, render, time, compare images); their
-//! reports ([`report`]: tables and JSON) and plot ([`plot`]: SVG). The `englobe` command parses its
+//! reports ([`report`]: tables and JSON; [`html_report`]: the comparison as one self-contained
+//! page) and plot ([`plot`]: SVG). The `englobe` command parses its
 //! arguments and calls these; a program can call them as well:
 //!
 //! ```no_run
@@ -16,11 +17,12 @@
 //! # Ok::<(), englobe_lab::LabError>(())
 //! ```
 //!
-//! [`error`] is the bottom module and [`seed_experiment`] and [`compare`] the top ones; no module
+//! [`error`] is the bottom module and [`seed_experiment`] and [`html_report`] the top ones; no module
 //! imports one above it.
 
 pub mod compare;
 pub mod error;
+pub mod html_report;
 pub mod measure;
 pub mod memory;
 pub mod plot;
