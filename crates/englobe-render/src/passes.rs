@@ -5,8 +5,8 @@
 //! Each pixel keeps its own generator and sum between passes and adds its samples in the order
 //! the tile renderer does ([`Renderer::render`]), so a render by passes that finishes writes the
 //! same bytes, and one stopped after `k` passes holds the image of a `k`-sample render (for
-//! `k >= 2`: one sample alone goes through the pixel centre). The price is memory: a generator
-//! and a sum per pixel, 28 bytes, which is why the tile renderer stays the default.
+//! `k >= 2`: one sample alone goes through the pixel centre). The price is memory: a generator, a
+//! sum and the pass's sample per pixel, 40 bytes, which is why the tile renderer stays the default.
 
 use std::sync::atomic::Ordering;
 use std::time::Instant;
