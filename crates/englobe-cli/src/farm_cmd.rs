@@ -170,11 +170,12 @@ fn run_slurm(args: SlurmArgs) -> anyhow::Result<ExitCode> {
         }
     };
     englobe_render::OutputFormat::from_path(&args.output)?;
-    let (mut scene, _) = read_scene(args.scene.as_ref())?;
-    args.image.apply(&mut scene);
+    if args.scene.as_ref().is_some_and(|p| p.as_os_str() == "-") {
+        bail!("the farm's tasks read the scene from a file: give its path, not `-`");
+    }
+    let (mut scene, _) = read_scene(args.scene.as_ref(), &args.image.overrides())?;
+    args.image.apply(&mut scene)?;
     let (width, height) = (scene.image.width, scene.image.height);
-    englobe_scene::ImageSettings::check_limits(width, height, scene.image.samples, scene.image.max_depth)
-        .map_err(anyhow::Error::msg)?;
     TileSpec { index: 0, count: args.tiles }.window(width, height).map_err(anyhow::Error::msg)?;
     let dir = args.tiles_dir.clone().unwrap_or_else(|| {
         let mut name = args.output.clone().into_os_string();
@@ -296,7 +297,7 @@ fn write_script(path: &Path, args: &SlurmArgs, plan: &Plan, dir: &Path) -> anyho
         render = render.join(" "),
     );
     englobe_render::output::write_atomically(path, |w| {
-        w.write_all(text.as_bytes()).map_err(|source| englobe_render::OutputError::Io { path: path.to_owned(), source })
+        w.write_all(text.as_bytes()).map_err(|error| englobe_render::OutputError::Io { path: path.to_owned(), error })
     })?;
     Ok(())
 }

@@ -1,7 +1,7 @@
 //! Ctrl-C: the first one asks the render to stop (no new tile starts, tiles in flight finish), a
 //! second one ends the process at once. Either way the exit code is 130 (128 + SIGINT), the
 //! convention of shells, and no image is written, so an existing file is never replaced by a
-//! partial one.
+//! partial one, unless `render --keep-partial` asked for the image of the sample passes done.
 
 use std::sync::atomic::{AtomicBool, Ordering};
 

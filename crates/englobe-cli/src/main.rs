@@ -13,6 +13,7 @@ mod info_cmd;
 mod interrupt;
 mod progress;
 mod render_cmd;
+mod scene_cmd;
 mod slurm;
 
 use std::process::ExitCode;
@@ -29,8 +30,11 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Render a scene file (or the embedded default scene) to PNG or EXR, or one tile of it.
+    /// Render a scene file (or the embedded default scene, or a mesh file framed) to PNG or EXR,
+    /// or one tile of it.
     Render(render_cmd::RenderArgs),
+    /// Print the scene that frames a mesh file, the one `render MESH` draws, to start a scene from.
+    Scene(scene_cmd::SceneArgs),
     /// Put tiles rendered with `render --tile` or `--pixel-bounds` together into one image,
     /// byte-identical to a single render; refuses missing, overlapping or foreign tiles.
     Assemble(assemble_cmd::AssembleArgs),
@@ -55,6 +59,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Render(args) => render_cmd::run(args),
+        Command::Scene(args) => scene_cmd::run(args),
         Command::Assemble(args) => assemble_cmd::run(args),
         Command::Farm(args) => farm_cmd::run(args),
         Command::Experiment(args) => experiment_cmd::run(args),

@@ -1,9 +1,10 @@
 //! `englobe render`: one scene to one image, with optional statistics, or one piece of an image
 //! (`--tile K/N`, `--pixel-bounds`) written as an OpenEXR tile for `englobe assemble`.
 
+use std::io::Read;
 use std::path::PathBuf;
 use std::process::ExitCode;
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use anyhow::Context;
 use clap::{Args, ValueEnum};
@@ -11,15 +12,19 @@ use englobe_lab::memory::peak_rss_bytes;
 use englobe_lab::report::{StatsReport, stats_table, write_json};
 use englobe_render::tile::file::{TileHeader, VERSION, write_tile};
 use englobe_render::{HeatmapScale, PixelWindow, Renderer, TileSpec, build_world, write_cost_image, write_image};
-use englobe_scene::{Scene, load_scene, parse_scene};
+use englobe_scene::framing::{framing_scene, turntable_position};
+use englobe_scene::mesh::MeshFormat;
+use englobe_scene::{Override, Scene, load_scene_with, parse_scene_with};
 
 use crate::image_options::{Balance, ImageOptions, render_digest};
 use crate::interrupt;
-use crate::progress::tile_bar;
+use crate::progress::{Phases, progress_bar, tile_bar};
 
-#[derive(Args)]
+#[derive(Args, Clone)]
 pub struct RenderArgs {
-    /// Scene file (TOML, see docs/scene-format.md); the embedded default scene if omitted.
+    /// Scene file (TOML, see docs/scene-format.md), `-` for standard input, or a mesh file (.obj,
+    /// .ply, .gltf, .glb) to see it framed (camera, ground, lights: the scene `englobe scene MESH`
+    /// prints); the embedded default scene if omitted.
     scene: Option<PathBuf>,
     /// Output image (.png or .exr); defaults to the scene's name with .png, in the current folder
     /// (with --tile or --pixel-bounds: an .exr tile, named after the scene and the tile).
@@ -57,6 +62,22 @@ pub struct RenderArgs {
     /// Write the statistics as JSON to this file.
     #[arg(long, value_name = "FILE")]
     stats_json: Option<PathBuf>,
+    /// Stop at the last complete sample pass once this much time has passed since the command
+    /// started (30s, 2m, 1.5h; a bare number is seconds) and write that image, saying so. Renders
+    /// pass by pass (every pixel's first sample, then every pixel's second...), which gives the
+    /// same image when it finishes.
+    #[arg(long, value_name = "DURATION", value_parser = parse_duration,
+          conflicts_with_all = ["tile", "pixel_bounds"])]
+    time_limit: Option<Duration>,
+    /// On Ctrl-C, write the image of the sample passes completed (instead of nothing), saying so;
+    /// renders pass by pass as --time-limit does.
+    #[arg(long, conflicts_with_all = ["tile", "pixel_bounds"])]
+    keep_partial: bool,
+    /// Render N frames with the camera turning once around the vertical axis through the point
+    /// it looks at, written as OUT-000.png, OUT-001.png...
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=10000),
+          conflicts_with_all = ["tile", "pixel_bounds"])]
+    turntable: Option<u32>,
     /// No progress bar and no summary line.
     #[arg(short, long)]
     quiet: bool,
@@ -80,43 +101,93 @@ pub enum CostScale {
     Linear,
 }
 
-/// The scene of the command line, or the embedded default, with its display name.
-pub fn read_scene(path: Option<&PathBuf>) -> anyhow::Result<(Scene, String)> {
+/// The scene of the command line (`-` reads it from standard input, a mesh file is framed, see
+/// `englobe_scene::framing`), or the embedded default, with `overrides` applied, and its display
+/// name.
+pub fn read_scene(path: Option<&PathBuf>, overrides: &[Override]) -> anyhow::Result<(Scene, String)> {
     match path {
-        Some(p) => Ok((load_scene(p)?, p.display().to_string())),
-        None => Ok((parse_scene(englobe_render::DEFAULT_SCENE, "default.toml".as_ref())?, "default".to_owned())),
+        Some(p) if MeshFormat::from_path(p).is_some() => {
+            let text = framing_scene(p)?;
+            // Named without a folder, so that the mesh path in the text, as given, is read from
+            // the current folder, as it will be from a scene printed by `englobe scene` there.
+            let name = format!("{} (framed)", p.file_name().unwrap_or(p.as_os_str()).to_string_lossy());
+            Ok((parse_scene_with(&text, name.as_ref(), overrides)?, p.display().to_string()))
+        }
+        Some(p) if p.as_os_str() == "-" => {
+            let text = read_stdin()?;
+            Ok((parse_scene_with(&text, STDIN_NAME.as_ref(), overrides)?, STDIN_NAME.to_owned()))
+        }
+        Some(p) => Ok((load_scene_with(p, overrides)?, p.display().to_string())),
+        None => Ok((
+            parse_scene_with(englobe_render::DEFAULT_SCENE, "default.toml".as_ref(), overrides)?,
+            "default".to_owned(),
+        )),
     }
+}
+
+/// How a scene read from standard input is named in messages; its mesh paths are relative to the
+/// current folder.
+const STDIN_NAME: &str = "<stdin>";
+
+fn read_stdin() -> anyhow::Result<String> {
+    let limit = englobe_scene::parse::MAX_SCENE_BYTES;
+    let mut bytes = Vec::new();
+    std::io::stdin()
+        .lock()
+        .take(limit + 1)
+        .read_to_end(&mut bytes)
+        .with_context(|| format!("{STDIN_NAME}: cannot read the scene"))?;
+    anyhow::ensure!(bytes.len() as u64 <= limit, "{STDIN_NAME}: the scene is larger than the {limit}-byte limit");
+    String::from_utf8(bytes).map_err(|e| {
+        anyhow::anyhow!("{STDIN_NAME}: byte {}: the scene is not valid UTF-8", e.utf8_error().valid_up_to())
+    })
 }
 
 pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
     let interrupted = interrupt::install()?;
-    let (mut scene, scene_name) = read_scene(args.scene.as_ref())?;
-    if !args.quiet {
-        for w in &scene.warnings {
-            eprintln!("warning: {w}");
+    let Some(frames) = args.turntable else { return render(&args, interrupted) };
+    // The camera of the scene as it will be rendered, then one render per frame with its position.
+    let (scene, _) = read_scene(args.scene.as_ref(), &args.image.overrides())?;
+    let (position, look_at) = (scene.camera.position, scene.camera.look_at);
+    let output = args.output.clone().unwrap_or_else(|| PathBuf::from(format!("{}.png", scene_stem(&args))));
+    let stem = output.with_extension("");
+    let ext = output.extension().map_or("png".into(), |e| e.to_string_lossy().into_owned());
+    for k in 0..frames {
+        let p = turntable_position(position, look_at, k, frames);
+        let mut frame = args.clone();
+        frame.turntable = None;
+        frame.output = Some(PathBuf::from(format!("{}-{k:03}.{ext}", stem.display())));
+        frame.image.set.push(Override { key: "camera.position".into(), value: format!("[{}, {}, {}]", p.x, p.y, p.z) });
+        let code = render(&frame, interrupted)?;
+        if code != ExitCode::SUCCESS {
+            return Ok(code);
         }
     }
-    args.image.apply(&mut scene);
-    let accel = args.image.accel;
-    let (width, height, samples, integrator) =
-        (scene.image.width, scene.image.height, scene.image.samples, scene.image.integrator);
-    let piece = match (args.tile, args.pixel_bounds) {
-        (Some(tile), _) => Some((tile.window(width, height).map_err(anyhow::Error::msg)?, Some(tile))),
-        (None, Some(window)) => {
-            window.check_inside(width, height).map_err(anyhow::Error::msg)?;
-            Some((window, None))
-        }
-        (None, None) => None,
-    };
-    let stem =
-        args.scene.as_ref().and_then(|p| p.file_stem()).map_or("englobe".into(), |s| s.to_string_lossy().into_owned());
-    let output = args.output.clone().unwrap_or_else(|| match piece {
-        Some((_, Some(tile))) => PathBuf::from(format!("{stem}.tile-{}-of-{}.exr", tile.index, tile.count)),
-        Some((w, None)) => PathBuf::from(format!("{stem}.window-{}-{}-{}-{}.exr", w.x0, w.x1, w.y0, w.y1)),
-        None => PathBuf::from(stem).with_extension("png"),
+    Ok(ExitCode::SUCCESS)
+}
+
+/// The scene's file name without its extension, or `englobe` for the default scene and standard
+/// input: what output files are named after.
+fn scene_stem(args: &RenderArgs) -> String {
+    args.scene
+        .as_ref()
+        .filter(|p| p.as_os_str() != "-")
+        .and_then(|p| p.file_stem())
+        .map_or("englobe".into(), |s| s.to_string_lossy().into_owned())
+}
+
+fn render(args: &RenderArgs, interrupted: &'static std::sync::atomic::AtomicBool) -> anyhow::Result<ExitCode> {
+    let wall = Instant::now();
+    // The destination is checked first, before the scene and its meshes are read: a long render
+    // must not end in "cannot write".
+    let stem = scene_stem(args);
+    let output = args.output.clone().unwrap_or_else(|| match (args.tile, args.pixel_bounds) {
+        (Some(tile), _) => PathBuf::from(format!("{stem}.tile-{}-of-{}.exr", tile.index, tile.count)),
+        (None, Some(w)) => PathBuf::from(format!("{stem}.window-{}-{}-{}-{}.exr", w.x0, w.x1, w.y0, w.y1)),
+        (None, None) => PathBuf::from(stem).with_extension("png"),
     });
-    let format = englobe_render::OutputFormat::from_path(&output)?;
-    if piece.is_some() {
+    let format = englobe_render::output::check_writable(&output)?;
+    if args.tile.is_some() || args.pixel_bounds.is_some() {
         anyhow::ensure!(
             format == englobe_render::OutputFormat::Exr,
             "{}: a tile is written as OpenEXR (.exr), so that `englobe assemble` gets the exact values",
@@ -128,9 +199,44 @@ pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
         );
     }
 
-    let build_start = Instant::now();
+    anyhow::ensure!(
+        args.aov == Aov::Color || (args.time_limit.is_none() && !args.keep_partial),
+        "--aov cost is not rendered by passes, so it cannot take --time-limit or --keep-partial"
+    );
+    let phases = Phases::new(args.quiet);
+    let shown_name = args.scene.as_ref().map_or("the default scene".into(), |p| p.display().to_string());
+    let phase = phases.begin(&format!("loading {shown_name}"));
+    let (mut scene, scene_name) = read_scene(args.scene.as_ref(), &args.image.overrides())?;
+    let load_seconds = phases.end(phase, |s| {
+        let triangles: usize = scene.objects.iter().map(|o| o.object.triangle_count()).sum();
+        format!(
+            "loaded {shown_name} in {s:.2} s: {} objects ({triangles} triangles in the picture), {} lights",
+            scene.objects.len(),
+            scene.lights.len()
+        )
+    });
+    if !args.quiet {
+        for w in &scene.warnings {
+            eprintln!("warning: {w}");
+        }
+    }
+    args.image.apply(&mut scene)?;
+    let accel = args.image.accel;
+    let (width, height, samples, integrator) =
+        (scene.image.width, scene.image.height, scene.image.samples, scene.image.integrator);
+    let piece = match (args.tile, args.pixel_bounds) {
+        (Some(tile), _) => Some((tile.window(width, height).map_err(anyhow::Error::msg)?, Some(tile))),
+        (None, Some(window)) => {
+            window.check_inside(width, height).map_err(anyhow::Error::msg)?;
+            Some((window, None))
+        }
+        (None, None) => None,
+    };
+
+    let phase = phases.begin(&format!("building {accel}"));
     let world = build_world(&scene, accel).context("cannot build the acceleration structure")?;
-    let build_seconds = build_start.elapsed().as_secs_f64();
+    let build_seconds =
+        phases.end(phase, |s| format!("built {accel} in {s:.2} s over {} triangles", world.triangle_count()));
 
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(args.threads.map_or(0, |t| t as usize))
@@ -147,26 +253,51 @@ pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
     let window = piece.map_or(PixelWindow::full(width, height), |(w, _)| w);
     let tiles = window.width().div_ceil(englobe_render::render::TILE_SIZE) as usize
         * window.height().div_ceil(englobe_render::render::TILE_SIZE) as usize;
-    let bar = tile_bar(tiles, args.quiet);
+    let by_passes = args.time_limit.is_some() || args.keep_partial;
+    let bar =
+        if by_passes { progress_bar(samples as usize, "passes", args.quiet) } else { tile_bar(tiles, args.quiet) };
     let progress = |done: usize, _total: usize| bar.set_position(done as u64);
     let out = pool.install(|| {
-        Renderer::new(&scene, &world)
+        let renderer = Renderer::new(&scene, &world)
             .window(window)
             .count_work(count_work)
             .record_cost(args.aov == Aov::Cost)
             .on_progress(&progress)
-            .cancel_flag(interrupted)
-            .render()
+            .cancel_flag(interrupted);
+        if by_passes { renderer.render_passes(args.time_limit.map(|t| wall + t)) } else { renderer.render() }
     })?;
     bar.finish_and_clear();
-    if !out.complete {
+    let ctrl_c = interrupted.load(std::sync::atomic::Ordering::Relaxed);
+    let mut exit = ExitCode::SUCCESS;
+    if !out.complete && !by_passes {
         eprintln!(
             "interrupted: stopped after {} of {tiles} tiles; no image written ({} left as it was)",
-            bar.position(),
+            out.tiles_done,
             output.display()
         );
         return Ok(ExitCode::from(interrupt::INTERRUPTED_EXIT_CODE));
     }
+    if !out.complete {
+        let done = out.samples_done;
+        let why = if ctrl_c {
+            "interrupted".to_owned()
+        } else {
+            format!("time limit of {} reached", show_duration(args.time_limit.unwrap_or_default()))
+        };
+        if done == 0 || (ctrl_c && !args.keep_partial) {
+            eprintln!(
+                "{why}: stopped after {done} of {samples} sample passes; no image written ({} left as it was)",
+                output.display()
+            );
+            let code = if ctrl_c { interrupt::INTERRUPTED_EXIT_CODE } else { 1 };
+            return Ok(ExitCode::from(code));
+        }
+        eprintln!("{why}: stopped after {done} of {samples} sample passes; writing the image of the {done} complete");
+        if ctrl_c {
+            exit = ExitCode::from(interrupt::INTERRUPTED_EXIT_CODE);
+        }
+    }
+    let samples = out.samples_done;
 
     if let Some((window, tile)) = piece {
         let header = TileHeader {
@@ -204,12 +335,14 @@ pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
             None => format!("{width}x{height}"),
         };
         println!(
-            "wrote {} ({what}, {samples} spp, {}, accel {}, {:.2} s on {} threads)",
+            "wrote {} ({what}, {samples} spp, {}, accel {}, {:.2} s on {} threads: load {load_seconds:.2} s, \
+             build {build_seconds:.2} s, render {:.2} s)",
             output.display(),
             integrator.name(),
             accel,
+            wall.elapsed().as_secs_f64(),
+            pool.current_num_threads(),
             out.seconds,
-            pool.current_num_threads()
         );
     }
     let peak_memory_bytes = peak_rss_bytes();
@@ -236,5 +369,29 @@ pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
         };
         write_json(path, &report)?;
     }
-    Ok(ExitCode::SUCCESS)
+    Ok(exit)
+}
+
+/// A duration such as `30s`, `2m`, `1.5h` or `90` (seconds).
+fn parse_duration(s: &str) -> Result<Duration, String> {
+    let t = s.trim();
+    let (number, unit) = match t.find(|c: char| c.is_ascii_alphabetic()) {
+        Some(at) => t.split_at(at),
+        None => (t, "s"),
+    };
+    let scale = match unit {
+        "ms" => 0.001,
+        "s" => 1.0,
+        "m" | "min" => 60.0,
+        "h" => 3600.0,
+        _ => return Err(format!("`{s}`: unknown unit `{unit}`; expected a duration such as 30s, 2m or 1.5h")),
+    };
+    match number.trim().parse::<f64>() {
+        Ok(x) if x > 0.0 && (x * scale) < 1e9 => Ok(Duration::from_secs_f64(x * scale)),
+        _ => Err(format!("`{s}`: expected a positive duration such as 30s, 2m or 1.5h")),
+    }
+}
+
+fn show_duration(d: Duration) -> String {
+    format!("{} s", d.as_secs_f64())
 }

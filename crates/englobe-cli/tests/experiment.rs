@@ -200,3 +200,55 @@ fn fewer_rays_casts_fewer_secondary_rays_for_a_measured_difference() {
         assert_eq!(r["rays"][0].as_u64(), full["rays"][0].as_u64(), "every pixel keeps its primary rays");
     }
 }
+
+#[test]
+fn a_claim_that_fails_says_why_and_counts_say_whose_and_at_which_size() {
+    let out = englobe()
+        .args([
+            "experiment",
+            "seed",
+            "--size",
+            "16",
+            "--tests",
+            "1,2",
+            "--accel",
+            "bvh-seed,bvh-seed-ordered,bvh-sah",
+            "-q",
+        ])
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        stdout.contains("Absolute counts are ours at 16x16, the size run, and the report's at its 512x512"),
+        "{stdout}"
+    );
+    assert!(stdout.contains("tests 16x16") && stdout.contains("report 512x512"), "{stdout}");
+    let lines: Vec<&str> = stdout.lines().collect();
+    let no: Vec<usize> = (0..lines.len()).filter(|&i| lines[i].trim_start().starts_with("[NO]")).collect();
+    // At this size bvh-sah is not below bvh-seed-ordered on test 1 (1 312 against 1 304).
+    assert!(!no.is_empty(), "{stdout}");
+    for i in no {
+        let why = lines.get(i + 1).copied().unwrap_or_default().trim_start();
+        assert!(why.starts_with("why not: ") && why.len() > 30, "{} is not explained: {why:?}", lines[i]);
+    }
+    assert!(stdout.contains("on test 1 bvh-sah makes 0.6 % more (1 312 against 1 304)"), "{stdout}");
+}
+
+#[test]
+fn compare_writes_a_self_contained_report_page() {
+    let dir = tempfile::tempdir().unwrap();
+    let report = dir.path().join("report");
+    let out = englobe()
+        .args(["compare", "--width", "40", "--accel", "bvh-sah,grid", "--full", "-q", "--report"])
+        .arg(&report)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let page_path = report.join("index.html");
+    assert!(String::from_utf8_lossy(&out.stdout).contains(&format!("wrote {}", page_path.display())));
+    let page = std::fs::read_to_string(&page_path).unwrap();
+    assert_eq!(page.matches("<img ").count(), 4, "the image and a heatmap for none, bvh-sah and grid");
+    assert_eq!(page.matches("src=\"data:image/png;base64,").count(), 4, "every picture inside the page");
+    assert!(page.contains("<svg") && page.contains("<table id=\"quality\">"));
+    assert!(std::fs::read_dir(&report).unwrap().count() == 1, "one file: the page holds everything");
+}

@@ -206,3 +206,30 @@ fn renders_default_to_the_fast_path() {
     assert!(out.status.success(), "{}", text(&out.stderr));
     assert_eq!(std::fs::read(&brute).unwrap(), std::fs::read(dir.path().join("sponza.png")).unwrap());
 }
+
+#[test]
+fn a_ply_of_triangle_strips_is_drawn_and_one_with_no_faces_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let header = "ply\nformat ascii 1.0\nelement vertex 8\nproperty float x\nproperty float y\nproperty float z\n";
+    let vertices: String = (0..4).map(|i| format!("{i} 0 0\n{i} 1 0\n")).collect();
+    let strips = dir.path().join("strips.ply");
+    std::fs::write(
+        &strips,
+        format!("{header}element tristrips 1\nproperty list int int vertex_indices\nend_header\n{vertices}9 0 1 2 3 -1 4 5 6 7\n"),
+    )
+    .unwrap();
+    let out = englobe(&["info", strips.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(text(&out.stdout).contains("triangles:  4\n"), "two strips of four vertices: {}", text(&out.stdout));
+
+    let points = dir.path().join("points.ply");
+    std::fs::write(&points, format!("{header}end_header\n{vertices}")).unwrap();
+    let out = englobe(&["info", points.to_str().unwrap()]);
+    assert!(!out.status.success());
+    assert!(
+        text(&out.stderr).contains("no `face` or `tristrips` element, so no surface to draw; its elements: vertex (8)"),
+        "{}",
+        text(&out.stderr)
+    );
+    assert!(!text(&out.stderr).contains('?'), "no guess: {}", text(&out.stderr));
+}

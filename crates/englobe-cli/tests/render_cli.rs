@@ -216,7 +216,13 @@ fn ctrl_c_stops_with_code_130_and_writes_nothing() {
     let mut err = String::new();
     std::io::Read::read_to_string(child.stderr.as_mut().unwrap(), &mut err).unwrap();
     assert_eq!(status.code(), Some(130), "{err}");
-    assert!(err.contains("interrupted: stopped after"), "{err}");
+    // The tiles really done, not the bar's end: fewer than all of them (20000 samples per pixel
+    // take minutes), and as many as the render finished.
+    let counts = err.split("stopped after ").nth(1).unwrap_or_else(|| panic!("{err}"));
+    let words: Vec<&str> = counts.split_whitespace().collect();
+    let (done, total): (usize, usize) = (words[0].parse().unwrap(), words[2].parse().unwrap());
+    assert_eq!((words[1], words[3], total), ("of", "tiles;", 300), "{err}");
+    assert!(done < total, "{done} of {total} tiles after 1.5 s of a render of minutes: {err}");
     assert_eq!(std::fs::read(dir.path().join("keep.png")).unwrap(), b"a good image");
     let leftovers: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
     assert_eq!(leftovers.len(), 1, "no temporary file is left behind");
@@ -263,4 +269,47 @@ fn killing_a_render_at_any_moment_never_leaves_a_broken_image() {
     }
     eprintln!("images seen after the kills: {outcomes:?}");
     assert!(outcomes.contains(&(30, 20)), "some kills came before the new image was in place");
+}
+
+/// `englobe` with `args` in `dir`, its standard error a terminal (through script(1)); what the
+/// terminal showed.
+#[cfg(target_os = "linux")]
+fn on_a_terminal(dir: &Path, args: &str) -> String {
+    let o = Command::new("script")
+        .args(["-qec", &format!("\"{}\" {args}", env!("CARGO_BIN_EXE_englobe")), "/dev/null"])
+        .current_dir(dir)
+        .output()
+        .expect("script(1) runs");
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+#[cfg(target_os = "linux")]
+#[test]
+fn phases_are_shown_on_a_terminal_with_counts_and_times_and_never_in_a_pipe() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = repo_root().join("scenes/bunny.toml").display().to_string();
+    let shown = on_a_terminal(dir.path(), &format!("render {scene} --scale 0.1 --spp 1 -o b.png"));
+    assert!(shown.contains(&format!("loaded {scene} in ")), "{shown}");
+    assert!(shown.contains("(69451 triangles in the picture), 2 lights"), "{shown}");
+    assert!(shown.contains("built bvh-wide in ") && shown.contains(" s over 69451 triangles"), "{shown}");
+    let quiet = on_a_terminal(dir.path(), &format!("render {scene} --scale 0.1 --spp 1 -q -o b.png"));
+    assert!(!quiet.contains("loaded") && !quiet.contains("wrote"), "{quiet}");
+    let piped = englobe(dir.path(), &["render", &scene, "--scale", "0.1", "--spp", "1", "-o", "b.png"]);
+    assert!(stderr(&piped).is_empty(), "a pipe gets no phases: {}", stderr(&piped));
+}
+
+#[test]
+fn the_summary_splits_the_wall_time_into_load_build_and_render() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = englobe(dir.path(), &["render", "--width", "64", "--spp", "1"]);
+    let line = stdout(&out);
+    let seconds = |after: &str| -> f64 {
+        let at = line.find(after).unwrap_or_else(|| panic!("no `{after}` in {line}")) + after.len();
+        line[at..].split(' ').next().unwrap().parse().unwrap()
+    };
+    let (wall, load, build, render) =
+        (seconds("accel bvh-wide, "), seconds("threads: load "), seconds("build "), seconds("render "));
+    assert!(line.trim_end().ends_with(" s)"), "{line}");
+    // Rounded to hundredths each, the parts cannot exceed the whole by more than the rounding.
+    assert!(load + build + render <= wall + 0.015, "{line}");
 }

@@ -271,3 +271,23 @@ if [ "$n" -lt 3 ]; then echo "77_1 RUNNING"; else exit 0; fi
     render(d, &["-o", "one.png"]);
     assert_eq!(std::fs::read(d.join("out.png")).unwrap(), std::fs::read(d.join("one.png")).unwrap());
 }
+
+#[test]
+fn farm_passes_scene_overrides_and_the_scale_to_its_tasks() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let bin = fake_slurm(d);
+    let log_s = d.join("submissions").display().to_string();
+    let s = scene();
+    let set = ["-D", "camera.fov=30", "--set", "image.max_depth=2", "--scale", "0.5"];
+    render(d, &[&["-o", "one.png"][..], &set].concat());
+    render(d, &["-o", "plain.png", "--scale", "0.5"]);
+    let mut farm: Vec<&str> = vec!["farm", "slurm", &s, "--tiles", "3", "-o", "out.png", "--poll", "0.05"];
+    farm.extend(SIZE);
+    farm.extend(set);
+    let o = ok(englobe_env(d, &farm, Some(&bin), &[("FAKE_SLURM_LOG", &log_s)]));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("wrote out.png (24x18 from 3 tiles"));
+    let out = std::fs::read(d.join("out.png")).unwrap();
+    assert_eq!(out, std::fs::read(d.join("one.png")).unwrap(), "the tasks rendered with the overrides");
+    assert_ne!(out, std::fs::read(d.join("plain.png")).unwrap());
+}

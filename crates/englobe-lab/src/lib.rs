@@ -4,7 +4,8 @@
 //! scenes and figures of [`seed_report`]), its other family of speed-ups, fewer rays
 //! ([`fewer_rays`], with [`image_error`] saying what an image loses) and the comparison of every acceleration structure on one
 //! scene ([`compare`]), both built on [`measure`] (build, render, time, compare images); their
-//! reports ([`report`]: tables and JSON) and plot ([`plot`]: SVG). The `englobe` command parses its
+//! reports ([`report`]: tables and JSON; [`html_report`]: the comparison as one self-contained
+//! page) and plot ([`plot`]: SVG). The `englobe` command parses its
 //! arguments and calls these; a program can call them as well:
 //!
 //! ```no_run
@@ -17,13 +18,14 @@
 //! # Ok::<(), englobe_lab::LabError>(())
 //! ```
 //!
-//! [`error`] is the bottom module and [`seed_experiment`] and [`compare`] the top ones; no module
+//! [`error`] is the bottom module and [`seed_experiment`] and [`html_report`] the top ones; no module
 //! imports one above it.
 
 pub mod compare;
 pub mod error;
 pub mod fewer_rays;
 pub mod image_error;
+pub mod html_report;
 pub mod measure;
 pub mod memory;
 pub mod plot;

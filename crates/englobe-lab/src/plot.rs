@@ -170,7 +170,7 @@ pub fn write_svg(path: &Path, title: &str, subtitle: &str, rows: &[PlotRow]) -> 
     let text = svg(title, subtitle, rows);
     englobe_render::output::write_atomically(path, |w| {
         use std::io::Write;
-        w.write_all(text.as_bytes()).map_err(|source| englobe_render::OutputError::Io { path: path.to_owned(), source })
+        w.write_all(text.as_bytes()).map_err(|error| englobe_render::OutputError::Io { path: path.to_owned(), error })
     })
     .map_err(|source| LabError::Plot { path: path.to_owned(), source })
 }

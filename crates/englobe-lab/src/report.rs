@@ -80,7 +80,7 @@ pub fn write_json(path: &Path, value: &impl Serialize) -> Result<(), LabError> {
         use std::io::Write;
         w.write_all(text.as_bytes())
             .and_then(|_| w.write_all(b"\n"))
-            .map_err(|source| englobe_render::OutputError::Io { path: path.to_owned(), source })
+            .map_err(|error| englobe_render::OutputError::Io { path: path.to_owned(), error })
     })?;
     Ok(())
 }

@@ -75,7 +75,7 @@ pub fn write_cost_image(cost: &CostImage, path: &Path, scale: HeatmapScale) -> R
                 return write_exr_rgb(w, path, cost.width(), cost.height(), |i| [values[i] as f32; 3]);
             }
         };
-        result.map_err(|source| OutputError::Encode { path: path.to_owned(), source })
+        result.map_err(|error| OutputError::Encode { path: path.to_owned(), error })
     })?;
     Ok(scale)
 }

@@ -23,6 +23,7 @@ pub mod film;
 pub mod heatmap;
 pub mod optics;
 pub mod output;
+mod passes;
 pub mod path;
 pub mod render;
 pub mod sampling;
@@ -32,7 +33,7 @@ pub mod supersample;
 pub mod tile;
 pub mod whitted;
 
-pub use camera::PinholeCamera;
+pub use camera::ImageCamera;
 pub use cost::{CostImage, write_cost_image};
 pub use film::Film;
 pub use heatmap::{Heatmap, HeatmapScale};

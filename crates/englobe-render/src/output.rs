@@ -20,31 +20,29 @@ pub enum OutputError {
     #[error("{}: unsupported image format; expected a file name ending in .png or .exr", .0.display())]
     UnknownFormat(PathBuf),
     /// The file system refused.
-    #[error("{}: cannot write: {source}", path.display())]
+    #[error("{}: cannot write: {error}", path.display())]
     Io {
         /// The destination.
         path: PathBuf,
-        /// The cause.
-        #[source]
-        source: std::io::Error,
+        /// What the system said (already part of the message, so not a separate source, which
+        /// would print it twice).
+        error: std::io::Error,
     },
     /// The encoder failed.
-    #[error("{}: cannot encode: {source}", path.display())]
+    #[error("{}: cannot encode: {error}", path.display())]
     Encode {
         /// The destination.
         path: PathBuf,
-        /// The cause.
-        #[source]
-        source: image::ImageError,
+        /// The cause (part of the message).
+        error: image::ImageError,
     },
     /// The OpenEXR encoder failed.
-    #[error("{}: cannot encode: {source}", path.display())]
+    #[error("{}: cannot encode: {error}", path.display())]
     EncodeExr {
         /// The destination.
         path: PathBuf,
-        /// The cause.
-        #[source]
-        source: exr::error::Error,
+        /// The cause (part of the message).
+        error: exr::error::Error,
     },
 }
 
@@ -87,7 +85,7 @@ pub fn write_image(film: &Film, path: &Path) -> Result<(), OutputError> {
                 return write_exr_rgb(w, path, wd, ht, |i| pixels[i].to_array());
             }
         };
-        result.map_err(|source| OutputError::Encode { path: path.to_owned(), source })
+        result.map_err(|error| OutputError::Encode { path: path.to_owned(), error })
     })
 }
 
@@ -108,7 +106,7 @@ pub fn write_exr_rgb(
     Image::from_encoded_channels((width, height as usize), EXR_ENCODING, channels)
         .write()
         .to_buffered(w)
-        .map_err(|source| OutputError::EncodeExr { path: path.to_owned(), source })
+        .map_err(|error| OutputError::EncodeExr { path: path.to_owned(), error })
 }
 
 /// Runs `write` on a temporary file beside `path`, then renames it to `path`. On any error the
@@ -117,7 +115,7 @@ pub fn write_atomically(
     path: &Path,
     write: impl FnOnce(&mut BufWriter<&mut std::fs::File>) -> Result<(), OutputError>,
 ) -> Result<(), OutputError> {
-    let io = |source| OutputError::Io { path: path.to_owned(), source };
+    let io = |error| OutputError::Io { path: path.to_owned(), error: without_path(error) };
     let dir = match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),
@@ -139,9 +137,66 @@ pub fn write_atomically(
     Ok(())
 }
 
+/// The system's error without the path of the temporary file that `tempfile` adds to it: the
+/// message names the destination, which is what the user asked for.
+fn without_path(error: std::io::Error) -> std::io::Error {
+    // tempfile wraps the system's error as "{error} at path {path:?}", keeping nothing else.
+    if error.get_ref().is_none() {
+        return error;
+    }
+    let text = error.to_string();
+    match text.rfind(" at path \"") {
+        Some(at) => std::io::Error::new(error.kind(), &text[..at]),
+        None => error,
+    }
+}
+
+/// Checks, before any work, that an image can be written at `path`: a known extension, a folder
+/// that exists, and the right to create a file in it (tried with a file created and removed at
+/// once), so that a long render never ends in "cannot write".
+pub fn check_writable(path: &Path) -> Result<OutputFormat, OutputError> {
+    let refuse = |message: &str| OutputError::Io { path: path.to_owned(), error: std::io::Error::other(message) };
+    if path.is_dir() {
+        return Err(refuse("it is a folder"));
+    }
+    let format = OutputFormat::from_path(path)?;
+    let dir = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    match std::fs::metadata(dir) {
+        Ok(m) if m.is_dir() => {}
+        Ok(_) => return Err(refuse(&format!("{} is not a folder", dir.display()))),
+        Err(_) => return Err(refuse(&format!("the folder {} does not exist", dir.display()))),
+    }
+    tempfile::Builder::new()
+        .prefix(".englobe-")
+        .suffix(".tmp")
+        .tempfile_in(dir)
+        .map_err(|error| OutputError::Io { path: path.to_owned(), error: without_path(error) })?;
+    Ok(format)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_write_error_names_the_destination_and_its_cause_once() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("gone").join("out.png");
+        let e = write_atomically(&path, |_| Ok(())).unwrap_err();
+        // As the command line shows it: the message, then each source.
+        let mut shown = e.to_string();
+        let mut source = std::error::Error::source(&e);
+        while let Some(s) = source {
+            shown += &format!(": {s}");
+            source = s.source();
+        }
+        assert!(shown.starts_with(&format!("{}: cannot write: ", path.display())), "{shown}");
+        assert_eq!(shown.matches("os error").count(), 1, "{shown}");
+        assert!(!shown.contains(".englobe-"), "the temporary file is not named: {shown}");
+    }
 
     #[test]
     fn png_round_trips_and_replaces_atomically() {

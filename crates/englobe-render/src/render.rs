@@ -18,7 +18,7 @@ use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg32;
 use rayon::prelude::*;
 
-use crate::camera::PinholeCamera;
+use crate::camera::ImageCamera;
 use crate::cost::CostImage;
 use crate::film::Film;
 use crate::path::PathTracer;
@@ -48,6 +48,12 @@ pub struct RenderOutput {
     pub stats: RenderStats,
     /// False if the render was cancelled before every tile was done (missing tiles are black).
     pub complete: bool,
+    /// Tiles of [`TILE_SIZE`] pixels finished, out of all the window's (a render by passes counts
+    /// the tiles of its passes' pixels: all of them, or none).
+    pub tiles_done: usize,
+    /// Samples per pixel the film holds: all those asked for, unless a render by passes stopped
+    /// early (see [`Renderer::render_passes`]).
+    pub samples_done: u32,
     /// Wall-clock seconds spent rendering.
     pub seconds: f64,
     /// Work per pixel (nodes visited plus exact tests) over the window, if [`Renderer::record_cost`]
@@ -57,18 +63,18 @@ pub struct RenderOutput {
 
 /// Renders a scene through its world: `Renderer::new(&scene, &world).size(640, 480).render()`.
 pub struct Renderer<'a> {
-    scene: &'a Scene,
-    world: &'a World,
-    width: u32,
-    height: u32,
-    samples: u32,
-    count_work: bool,
-    record_cost: bool,
-    stride: u32,
-    window: Option<PixelWindow>,
-    progress: Option<&'a (dyn Fn(usize, usize) + Sync)>,
-    cancel: Option<&'a AtomicBool>,
-    integrator: IntegratorKind,
+    pub(crate) scene: &'a Scene,
+    pub(crate) world: &'a World,
+    pub(crate) width: u32,
+    pub(crate) height: u32,
+    pub(crate) samples: u32,
+    pub(crate) count_work: bool,
+    pub(crate) record_cost: bool,
+    pub(crate) stride: u32,
+    pub(crate) window: Option<PixelWindow>,
+    pub(crate) progress: Option<&'a (dyn Fn(usize, usize) + Sync)>,
+    pub(crate) cancel: Option<&'a AtomicBool>,
+    pub(crate) integrator: IntegratorKind,
 }
 
 impl<'a> Renderer<'a> {
@@ -169,11 +175,7 @@ impl<'a> Renderer<'a> {
 
     fn render_with<C: Counters + Copy + Send + Into<WorkCounts>>(&self) -> RenderOutput {
         let start = Instant::now();
-        let camera = PinholeCamera::new(&self.scene.camera, self.width, self.height);
-        let integrator = match self.integrator {
-            IntegratorKind::Whitted => Integrator::Whitted(Whitted::new(self.scene, self.world)),
-            IntegratorKind::Path => Integrator::Path(PathTracer::new(self.scene, self.world)),
-        };
+        let (camera, integrator) = self.parts();
         let window = self.window.unwrap_or(PixelWindow::full(self.width, self.height));
         let tiles_x = window.width().div_ceil(TILE_SIZE);
         let tiles_y = window.height().div_ceil(TILE_SIZE);
@@ -229,11 +231,13 @@ impl<'a> Renderer<'a> {
         let mut cost = self.record_cost.then(|| CostImage::new(window.width(), window.height()));
         let mut stats = RenderStats::default();
         let mut complete = true;
+        let mut tiles_done = 0;
         for (index, tile) in tiles.into_iter().enumerate() {
             let Some(tile) = tile else {
                 complete = false;
                 continue;
             };
+            tiles_done += 1;
             stats.add(&tile.stats);
             let (x0, y0, x1, y1) = tile_at(index);
             let mut it = tile.pixels.into_iter();
@@ -247,40 +251,79 @@ impl<'a> Renderer<'a> {
                 }
             }
         }
-        RenderOutput { film, window, stats, complete, seconds: start.elapsed().as_secs_f64(), cost }
+        let samples_done = if complete { self.samples } else { 0 };
+        RenderOutput {
+            film,
+            window,
+            stats,
+            complete,
+            tiles_done,
+            samples_done,
+            seconds: start.elapsed().as_secs_f64(),
+            cost,
+        }
     }
 
     fn pixel<C: Counters>(
         &self,
-        camera: &PinholeCamera,
+        camera: &ImageCamera,
         integrator: &Integrator,
         x: u32,
         y: u32,
         tally: &mut Tally<C>,
     ) -> Vec3 {
         let mut rng = pixel_rng(self.scene.image.seed, x, y);
-        let mut sample = |rng: &mut Pcg32, dx: f32, dy: f32| {
-            let ray = camera.ray(x as f32 + dx, y as f32 + dy);
-            match integrator {
-                Integrator::Whitted(w) => w.radiance(&ray, tally),
-                Integrator::Path(p) => p.radiance(&ray, rng, tally),
-            }
-        };
         if self.samples == 1 {
-            // One sample goes through the pixel's centre, as the seed's renderer did.
-            return sample(&mut rng, 0.5, 0.5);
+            return self.sample(camera, integrator, x, y, &mut rng, tally);
         }
         let mut sum = Vec3::ZERO;
         for _ in 0..self.samples {
-            let (dx, dy): (f32, f32) = (rng.random(), rng.random());
-            sum += sample(&mut rng, dx, dy);
+            sum += self.sample(camera, integrator, x, y, &mut rng, tally);
         }
         sum / self.samples as f32
+    }
+
+    /// The next sample of pixel `(x, y)`, whose generator is `rng`: through the pixel's centre
+    /// when the render takes one sample per pixel (as the seed's renderer did), jittered over the
+    /// pixel otherwise. A render by passes calls it in the same order per pixel, so the sums are
+    /// the same.
+    #[inline]
+    pub(crate) fn sample<C: Counters>(
+        &self,
+        camera: &ImageCamera,
+        integrator: &Integrator,
+        x: u32,
+        y: u32,
+        rng: &mut Pcg32,
+        tally: &mut Tally<C>,
+    ) -> Vec3 {
+        let (dx, dy): (f32, f32) = if self.samples == 1 { (0.5, 0.5) } else { (rng.random(), rng.random()) };
+        let ray = if camera.has_lens() {
+            // Drawn only with a lens, so that pinhole images keep their random numbers.
+            let (u, v): (f32, f32) = (rng.random(), rng.random());
+            camera.ray_through_lens(x as f32 + dx, y as f32 + dy, u, v)
+        } else {
+            camera.ray(x as f32 + dx, y as f32 + dy)
+        };
+        match integrator {
+            Integrator::Whitted(w) => w.radiance(&ray, tally),
+            Integrator::Path(p) => p.radiance(&ray, rng, tally),
+        }
+    }
+
+    /// The camera and the integrator of a render.
+    pub(crate) fn parts(&self) -> (ImageCamera, Integrator<'a>) {
+        let camera = ImageCamera::new(&self.scene.camera, self.width, self.height);
+        let integrator = match self.integrator {
+            IntegratorKind::Whitted => Integrator::Whitted(Whitted::new(self.scene, self.world)),
+            IntegratorKind::Path => Integrator::Path(PathTracer::new(self.scene, self.world)),
+        };
+        (camera, integrator)
     }
 }
 
 /// The integrator a render uses.
-enum Integrator<'a> {
+pub(crate) enum Integrator<'a> {
     Whitted(Whitted<'a>),
     Path(PathTracer<'a>),
 }

@@ -242,3 +242,53 @@ fn a_pixel_stride_renders_the_same_pixels_and_only_them() {
     let primary = sample.stats.kind(RayKind::Primary).rays;
     assert_eq!(primary, 10 * 8 * scene.image.samples as u64);
 }
+
+#[test]
+fn a_render_by_passes_writes_the_bytes_of_the_tile_renderer() {
+    let mut s = scene(DEFAULT_SCENE);
+    s.image.width = 50;
+    s.image.height = 37;
+    let world = build_world(&s, AccelKind::BvhWide).unwrap();
+    for (samples, integrator) in [
+        (1, englobe_scene::IntegratorKind::Whitted),
+        (3, englobe_scene::IntegratorKind::Whitted),
+        (4, englobe_scene::IntegratorKind::Path),
+    ] {
+        let r = Renderer::new(&s, &world).samples(samples).integrator(integrator).count_work(true);
+        let tiles = r.render().unwrap();
+        let passes = r.render_passes(None).unwrap();
+        assert!(passes.complete && passes.samples_done == samples);
+        let bits =
+            |o: &RenderOutput| o.film.pixels().iter().flat_map(|p| p.to_array().map(f32::to_bits)).collect::<Vec<_>>();
+        assert_eq!(bits(&tiles), bits(&passes), "{samples} samples, {integrator:?}");
+        assert_eq!(tiles.stats.total(), passes.stats.total());
+    }
+}
+
+#[test]
+fn a_render_by_passes_stopped_early_holds_its_complete_passes() {
+    let mut s = scene(DEFAULT_SCENE);
+    s.image.width = 40;
+    s.image.height = 30;
+    let world = build_world(&s, AccelKind::BvhWide).unwrap();
+    // Cancelled after the third pass: the image of a 3-sample render.
+    let flag = std::sync::atomic::AtomicBool::new(false);
+    let stop_after_3 = |done: usize, _: usize| {
+        if done == 3 {
+            flag.store(true, std::sync::atomic::Ordering::SeqCst);
+        }
+    };
+    let stopped = Renderer::new(&s, &world)
+        .samples(64)
+        .on_progress(&stop_after_3)
+        .cancel_flag(&flag)
+        .render_passes(None)
+        .unwrap();
+    assert!(!stopped.complete);
+    assert_eq!(stopped.samples_done, 3);
+    let three = Renderer::new(&s, &world).samples(3).render().unwrap();
+    assert_eq!(stopped.film.pixels(), three.film.pixels());
+    // A deadline already passed: no pass, an empty film.
+    let none = Renderer::new(&s, &world).samples(8).render_passes(Some(std::time::Instant::now())).unwrap();
+    assert_eq!((none.samples_done, none.complete), (0, false));
+}

@@ -69,6 +69,20 @@ pub struct CameraDef {
     pub look_at: Spanned<Point>,
     pub up: Option<Spanned<Point>>,
     pub fov: Option<Spanned<Finite>>,
+    #[serde(default)]
+    pub projection: ProjectionKind,
+    pub view_height: Option<Spanned<Positive>>,
+    pub aperture: Option<NonNegative>,
+    pub focus_distance: Option<Positive>,
+}
+
+/// The camera's `projection`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ProjectionKind {
+    #[default]
+    Perspective,
+    Orthographic,
 }
 
 #[derive(Debug, Deserialize)]

@@ -7,9 +7,11 @@
 
 pub mod error;
 pub mod format;
+pub mod framing;
 pub mod mesh;
 pub mod model;
 pub mod numbers;
+pub mod overrides;
 pub mod parse;
 mod parse_mesh;
 pub mod random_triangles;
@@ -17,9 +19,10 @@ pub mod shared_data;
 
 pub use error::{Located, SceneError};
 pub use model::{
-    Camera, ImageSettings, IntegratorKind, Light, MAX_DEPTH, MAX_PIXELS, MAX_SAMPLES, Material, MaterialId, Scene,
-    SceneObject,
+    Camera, ImageSettings, IntegratorKind, Light, MAX_DEPTH, MAX_PIXELS, MAX_SAMPLES, Material, MaterialId, Projection,
+    Scene, SceneObject,
 };
-pub use parse::{DEFAULT_MATERIAL, load_scene, parse_scene};
+pub use overrides::Override;
+pub use parse::{DEFAULT_MATERIAL, load_scene, load_scene_with, parse_scene, parse_scene_with};
 pub use parse_mesh::MAX_MESH_INSTANCES;
 pub use random_triangles::MAX_RANDOM_TRIANGLES;

@@ -79,17 +79,50 @@ impl ImageSettings {
     }
 }
 
-/// A pinhole perspective camera.
+/// A camera: perspective or orthographic, a pinhole or a thin lens.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Camera {
-    /// Eye position.
+    /// Eye position (for an orthographic camera, the centre of the plane rays start from).
     pub position: Vec3,
     /// Point the camera looks at (distinct from `position`).
     pub look_at: Vec3,
     /// Up direction (not parallel to the view direction).
     pub up: Vec3,
-    /// Vertical field of view, in degrees, in `(0, 180)`.
+    /// Vertical field of view, in degrees, in `(0, 180)` (perspective).
     pub fov_degrees: f32,
+    /// How points are projected onto the image.
+    pub projection: Projection,
+    /// Radius of the thin lens; 0 is a pinhole (everything sharp).
+    pub lens_radius: f32,
+    /// Distance along the view direction of the plane in focus (positive).
+    pub focus_distance: f32,
+}
+
+impl Camera {
+    /// A pinhole perspective camera.
+    pub fn pinhole(position: Vec3, look_at: Vec3, up: Vec3, fov_degrees: f32) -> Self {
+        Camera {
+            position,
+            look_at,
+            up,
+            fov_degrees,
+            projection: Projection::Perspective,
+            lens_radius: 0.0,
+            focus_distance: (look_at - position).length(),
+        }
+    }
+}
+
+/// How a camera projects the scene.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Projection {
+    /// Rays from the eye through the image plane: far things look smaller.
+    Perspective,
+    /// Parallel rays along the view direction: sizes do not depend on distance.
+    Orthographic {
+        /// Height of the view, in scene units (the width follows the image's aspect ratio).
+        view_height: f32,
+    },
 }
 
 /// A light source.

@@ -7,11 +7,14 @@ use std::ops::Range;
 use std::path::Path;
 
 use englobe::{AaBox, Object, Plane, Sphere, Triangle, Vec3};
+use serde::Deserialize;
 use toml::Spanned;
+use toml::de::DeTable;
 
-use crate::error::SceneError;
-use crate::format::{CameraDef, ImageDef, MaterialDef, SceneFile};
-use crate::model::{Camera, ImageSettings, Light, Material, MaterialId, Scene, SceneObject};
+use crate::error::{Located, SceneError};
+use crate::format::{CameraDef, ImageDef, MaterialDef, ProjectionKind, SceneFile};
+use crate::model::{Camera, ImageSettings, Light, Material, MaterialId, Projection, Scene, SceneObject};
+use crate::overrides::{Override, Placed};
 
 /// Name of the material objects get when they name none.
 pub const DEFAULT_MATERIAL: &str = "default";
@@ -22,30 +25,53 @@ pub const MAX_SCENE_BYTES: u64 = 64 << 20;
 
 /// Reads and validates the scene file at `path`.
 pub fn load_scene(path: &Path) -> Result<Scene, SceneError> {
+    load_scene_with(path, &[])
+}
+
+/// Reads the scene file at `path`, applies `overrides` (see [`crate::overrides`]) and validates
+/// the result.
+pub fn load_scene_with(path: &Path, overrides: &[Override]) -> Result<Scene, SceneError> {
     let meta = std::fs::metadata(path).map_err(|e| SceneError::io(path, e))?;
     if meta.is_dir() {
         return Err(SceneError::io(path, std::io::Error::other("is a directory, expected a scene file")));
     }
+    let too_large = |bytes: String| {
+        SceneError::io(path, std::io::Error::other(format!("{bytes} is larger than the {MAX_SCENE_BYTES}-byte limit")))
+    };
     if meta.len() > MAX_SCENE_BYTES {
-        return Err(SceneError::io(
-            path,
-            std::io::Error::other(format!("{} bytes is larger than the {MAX_SCENE_BYTES}-byte limit", meta.len())),
-        ));
+        return Err(too_large(format!("{} bytes", meta.len())));
     }
-    let bytes = std::fs::read(path).map_err(|e| SceneError::io(path, e))?;
+    // A device or a pipe has no size beforehand: the limit holds while reading.
+    let file = std::fs::File::open(path).map_err(|e| SceneError::io(path, e))?;
+    let bytes = crate::mesh::read_at_most(file, meta.len() as usize, MAX_SCENE_BYTES + 1)
+        .map_err(|e| SceneError::io(path, e))?;
+    if bytes.len() as u64 > MAX_SCENE_BYTES {
+        return Err(too_large("the file".into()));
+    }
     let text = String::from_utf8(bytes).map_err(|e| {
         let at = e.utf8_error().valid_up_to();
         SceneError::at(&path.display().to_string(), "", None, format!("byte {at}: the file is not valid UTF-8"))
     })?;
-    parse_scene(&text, path)
+    parse_scene_with(&text, path, overrides)
 }
 
 /// Validates scene `text`; `file` names it in errors.
 pub fn parse_scene(text: &str, file: &Path) -> Result<Scene, SceneError> {
+    parse_scene_with(text, file, &[])
+}
+
+/// Applies `overrides` to scene `text` and validates the result; `file` names the text in errors,
+/// and an error in an overridden value names the override.
+pub fn parse_scene_with(text: &str, file: &Path, overrides: &[Override]) -> Result<Scene, SceneError> {
     let name = file.display().to_string();
-    let def: SceneFile =
-        toml::from_str(text).map_err(|e| SceneError::at(&name, text, e.span(), e.message().to_owned()))?;
-    Converter { file: &name, text, dir: file.parent().unwrap_or(Path::new("")) }.scene(def)
+    let placed = Placed::new(text.len(), overrides);
+    let invalid = |span: Option<Range<usize>>, message: &str| {
+        SceneError::Invalid(placed.locate(&name, text, span, message.to_owned()))
+    };
+    let mut root = DeTable::parse(text).map_err(|e| invalid(e.span(), e.message()))?;
+    crate::overrides::apply(root.get_mut(), overrides, &placed, &name, text).map_err(SceneError::Invalid)?;
+    let def = SceneFile::deserialize(toml::de::Deserializer::from(root)).map_err(|e| invalid(e.span(), e.message()))?;
+    Converter { file: &name, text, dir: file.parent().unwrap_or(Path::new("")), placed: &placed }.scene(def)
 }
 
 pub(crate) struct Converter<'a> {
@@ -53,11 +79,17 @@ pub(crate) struct Converter<'a> {
     pub(crate) text: &'a str,
     /// The scene file's folder, against which mesh paths are resolved.
     pub(crate) dir: &'a Path,
+    /// Where the command line's overrides stand, for errors in their values.
+    pub(crate) placed: &'a Placed,
 }
 
 impl Converter<'_> {
     pub(crate) fn err(&self, span: Range<usize>, message: impl Into<String>) -> SceneError {
-        SceneError::at(self.file, self.text, Some(span), message)
+        SceneError::Invalid(self.locate(span, message))
+    }
+
+    pub(crate) fn locate(&self, span: Range<usize>, message: impl Into<String>) -> Located {
+        self.placed.locate(self.file, self.text, Some(span), message.into())
     }
 
     fn scene(&self, def: SceneFile) -> Result<Scene, SceneError> {
@@ -204,7 +236,28 @@ impl Converter<'_> {
             Some(f) => f.get_ref().0,
             None => 45.0,
         };
-        Ok(Camera { position, look_at, up, fov_degrees })
+        let distance = view.length();
+        let projection = match (c.projection, &c.view_height) {
+            (ProjectionKind::Perspective, Some(h)) => {
+                return Err(self.err(h.span(), "`view_height` is for `projection = \"orthographic\"`"));
+            }
+            (ProjectionKind::Perspective, None) => Projection::Perspective,
+            (ProjectionKind::Orthographic, h) => Projection::Orthographic {
+                // By default, the size the perspective view has at the look-at point.
+                view_height: h
+                    .as_ref()
+                    .map_or(2.0 * distance * (fov_degrees.to_radians() * 0.5).tan(), |h| h.get_ref().0),
+            },
+        };
+        Ok(Camera {
+            position,
+            look_at,
+            up,
+            fov_degrees,
+            projection,
+            lens_radius: c.aperture.map_or(0.0, |a| a.0 * 0.5),
+            focus_distance: c.focus_distance.map_or(distance, |f| f.0),
+        })
     }
 
     fn materials(

@@ -193,7 +193,7 @@ fn rotation(degrees: Vec3) -> Quat {
 }
 
 fn located(c: &Converter, span: std::ops::Range<usize>, message: String) -> Located {
-    Located::at(c.file, c.text, Some(span), message)
+    c.locate(span, message)
 }
 
 #[cfg(test)]

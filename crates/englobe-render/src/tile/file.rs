@@ -107,7 +107,7 @@ pub fn write_tile(path: &Path, header: &TileHeader, film: &Film) -> Result<(), T
         .map_err(|source| TileError::Exr { path: path.to_owned(), source })?;
     write_atomically(path, |out| {
         std::io::Write::write_all(out, bytes.get_ref())
-            .map_err(|source| OutputError::Io { path: path.to_owned(), source })
+            .map_err(|error| OutputError::Io { path: path.to_owned(), error })
     })?;
     Ok(())
 }

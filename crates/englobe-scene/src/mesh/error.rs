@@ -42,6 +42,13 @@ pub enum MeshErrorKind {
         /// The limit.
         limit: u64,
     },
+    /// A file with no size known beforehand (a device, a pipe) gave more bytes than englobe reads;
+    /// reading stopped there.
+    #[error("more than the limit of {limit} bytes (not a regular file, so read up to the limit, then refused)")]
+    StreamTooLarge {
+        /// The limit.
+        limit: u64,
+    },
     /// The extension names no format englobe reads.
     #[error("unknown mesh format `{0}`: expected .obj, .ply, .gltf or .glb")]
     UnknownFormat(String),

@@ -25,6 +25,7 @@ pub use error::{MeshErrorKind, MeshFileError, Position};
 pub use loaded::{LoadedMesh, MAX_MESH_FILE_BYTES, MAX_MTL_FILE_BYTES, MeshFormat, NO_MATERIAL, NamedMaterial};
 pub use transform::bake_transform;
 
+pub(crate) use read::read_at_most;
 use read::{check_file, read_limited};
 
 /// Reads and checks the mesh file `path`, choosing the format by its extension.

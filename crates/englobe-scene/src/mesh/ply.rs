@@ -2,7 +2,8 @@
 //! ASCII, binary little-endian and binary big-endian bodies; `\n` or `\r\n` header lines; any
 //! elements and properties, of which englobe keeps the vertex positions (`x y z`), normals
 //! (`nx ny nz`), texture coordinates (`u v`, `s t` or `texture_u texture_v`) and the face lists
-//! (`vertex_indices` or `vertex_index`), fan- or ear-triangulated. Everything else is skipped.
+//! (`vertex_indices` or `vertex_index`), fan- or ear-triangulated, or the triangle strips of a
+//! `tristrips` element (older scanned-model archives store faces so). Everything else is skipped.
 //!
 //! Before anything is allocated, the counts the header declares are checked against the bytes
 //! the file holds, so `element vertex 4294967295` in a 100-byte file is an error, not an attempt

@@ -96,9 +96,17 @@ fn read_elements(v: &mut impl Values, header: &Header) -> Result<Body, MeshFileE
     let Some(vertex_el) = header.elements.iter().position(|e| e.name == "vertex") else {
         return Err(no_triangles(": the file has no `vertex` element"));
     };
-    let Some(face_el) = header.elements.iter().position(|e| e.name == "face") else {
-        return Err(no_triangles(": the file has no `face` element (a point cloud?)"));
+    // Faces as polygons (`face`), or as triangle strips (`tristrips`, as some scanners wrote them).
+    let face_el = header.elements.iter().position(|e| e.name == "face");
+    let Some(face_el) = face_el.or_else(|| header.elements.iter().position(|e| e.name == "tristrips")) else {
+        let names: Vec<String> = header.elements.iter().map(|e| format!("{} ({})", e.name, e.count)).collect();
+        return Err(no_triangles(&format!(
+            ": the file has no `face` or `tristrips` element, so no surface to draw; its elements: {}",
+            names.join(", ")
+        )));
     };
+    let strips = header.elements[face_el].name == "tristrips";
+    let faces = &header.elements[face_el].name;
     let roles: Vec<Role> = header.elements[vertex_el]
         .properties
         .iter()
@@ -126,7 +134,9 @@ fn read_elements(v: &mut impl Values, header: &Header) -> Result<Body, MeshFileE
         return Err(MeshFileError::line(
             &path,
             line,
-            MeshErrorKind::Malformed("the face element needs a list property vertex_indices (or vertex_index)".into()),
+            MeshErrorKind::Malformed(format!(
+                "the {faces} element needs a list property vertex_indices (or vertex_index)"
+            )),
         ));
     };
     if let Property::List { item, .. } = &header.elements[face_el].properties[index_list] {
@@ -183,7 +193,9 @@ fn read_elements(v: &mut impl Values, header: &Header) -> Result<Body, MeshFileE
                         }
                         let c = c as u64;
                         v.check_list(c, *item)?;
-                        if e_index == face_el && k == index_list && c >= 3 {
+                        if e_index == face_el && k == index_list && strips {
+                            read_strip(v, c, *item, vertices_read, &mut out)?;
+                        } else if e_index == face_el && k == index_list && c >= 3 {
                             read_face(v, c, *item, vertices_read, &mut out)?;
                         } else {
                             if e_index == face_el && k == index_list {
@@ -257,6 +269,49 @@ fn read_face(
         out.face_indices.push(index as u32);
     }
     out.face_sizes.push(count as u32);
+    Ok(())
+}
+
+/// One triangle strip: `-1` ends a strip and starts the next; in each, vertices `j, j+1, j+2` make
+/// a triangle, every second one with its first two swapped so that all keep the strip's winding.
+/// Triangles with a repeated vertex (the joins that strippers insert) are dropped.
+fn read_strip(
+    v: &mut impl Values,
+    count: u64,
+    item: Scalar,
+    vertices: Option<u64>,
+    out: &mut Body,
+) -> Result<(), MeshFileError> {
+    let limit = vertices.unwrap_or(u32::MAX as u64);
+    let mut strip: Vec<u32> = Vec::new();
+    let emit = |strip: &mut Vec<u32>, out: &mut Body| {
+        for j in 0..strip.len().saturating_sub(2) {
+            let (a, b, c) = (strip[j], strip[j + 1], strip[j + 2]);
+            let t = if j % 2 == 0 { [a, b, c] } else { [b, a, c] };
+            if t[0] != t[1] && t[1] != t[2] && t[0] != t[2] {
+                out.face_indices.extend(t);
+                out.face_sizes.push(3);
+            }
+        }
+        strip.clear();
+    };
+    for _ in 0..count {
+        let index = v.int(item)?;
+        if index == -1 {
+            emit(&mut strip, out);
+            continue;
+        }
+        if index < 0 || index as u64 >= limit {
+            return Err(v.error(MeshErrorKind::IndexOutOfRange {
+                what: "vertex",
+                index: index.to_string(),
+                available: limit,
+                context: if vertices.is_some() { " (-1 ends a strip)" } else { " (indices must fit 32 bits)" },
+            }));
+        }
+        strip.push(index as u32);
+    }
+    emit(&mut strip, out);
     Ok(())
 }
 
