@@ -17,9 +17,10 @@ use crate::image_options::parse_accel;
 pub enum Experiment {
     /// The seed report's four tests.
     Seed,
-    /// Fewer rays: adaptive depth at several thresholds against full depth, on the seed's scenes,
-    /// the glass, mirrors and Sponza scenes (or the SCENEs given): rays per kind, exact tests,
-    /// time, and the image's difference (RMSE, SSIM).
+    /// Fewer rays: adaptive depth at several thresholds against full depth, and adaptive
+    /// supersampling against uniform supersampling, on the seed's scenes, the glass, mirrors and
+    /// Sponza scenes (or the SCENEs given): rays per kind, exact tests, time, and the image's
+    /// difference (RMSE, SSIM).
     FewerRays,
 }
 

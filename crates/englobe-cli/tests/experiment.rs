@@ -186,7 +186,9 @@ fn fewer_rays_casts_fewer_secondary_rays_for_a_measured_difference() {
     let table = String::from_utf8_lossy(&out.stdout);
     assert!(table.contains("cornell-box-path.toml: path traced"), "{table}");
     let report: Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
-    let rows = rows(&report);
+    let all = rows(&report);
+    let method = |m: &str| all.iter().filter(|r| r["method"] == m).collect::<Vec<_>>();
+    let rows: Vec<&Value> = [method("full depth"), method("adaptive depth")].concat();
     assert_eq!(rows.len(), 3, "the reference and two thresholds");
     let secondary = |r: &Value| r["rays"][2].as_u64().unwrap() + r["rays"][3].as_u64().unwrap();
     let (full, coarse, fine) = (&rows[0], &rows[1], &rows[2]);
@@ -196,9 +198,17 @@ fn fewer_rays_casts_fewer_secondary_rays_for_a_measured_difference() {
     let rmse = |r: &Value| r["error"]["rmse"].as_f64().unwrap();
     assert!(rmse(coarse) > rmse(fine) && rmse(coarse) > 0.0, "{table}");
     assert!(count(coarse, "exact_tests") < count(full, "exact_tests"));
-    for r in rows {
+    for r in &rows {
         assert_eq!(r["rays"][0].as_u64(), full["rays"][0].as_u64(), "every pixel keeps its primary rays");
     }
+    // Supersampling: the 64-sample reference, uniform 4 and 16, and three adaptive settings, the
+    // finest of which takes more primary rays than the coarsest.
+    let (uniform, adaptive) = (method("uniform"), method("adaptive ss"));
+    assert_eq!((method("uniform, reference").len(), uniform.len(), adaptive.len()), (1, 2, 3), "{table}");
+    let primary = |r: &Value| r["rays"][0].as_u64().unwrap();
+    assert_eq!(primary(uniform[0]), 4 * 64 * 48, "4 spp on 64x48");
+    assert!(primary(adaptive[0]) >= 4 * 64 * 48 && primary(adaptive[0]) < primary(adaptive[2]), "{table}");
+    assert!(rmse(uniform[1]) < rmse(uniform[0]), "16 spp is closer to the reference than 4: {table}");
 }
 
 #[test]

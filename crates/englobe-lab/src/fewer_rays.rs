@@ -2,18 +2,22 @@
 //! seed's way: rays cast and exact tests per kind of ray, the time, and what the image loses
 //! against a full render (see [`crate::image_error`]).
 //!
-//! The method measured so far is adaptive depth (Hall and Greenberg 1983, "A Testbed for
-//! Realistic Image Synthesis"): secondary rays whose contribution to the pixel would fall below a
-//! threshold are not cast (the scene's `min_contribution`, see englobe-render's `whitted`). Each
-//! Whitted scene is rendered once at full depth (the reference) and once per threshold;
-//! path-traced scenes are skipped, their depth being a matter of Russian roulette, not of a fixed
-//! tree.
+//! Two methods are measured, on Whitted scenes (path-traced ones are skipped: their depth is a
+//! matter of Russian roulette, and their noise would make every square look like an edge):
+//!
+//! - adaptive depth (Hall and Greenberg 1983, "A Testbed for Realistic Image Synthesis"):
+//!   secondary rays whose contribution to the pixel would fall below a threshold are not cast
+//!   (the scene's `min_contribution`, see englobe-render's `whitted`), against the full depth;
+//! - adaptive supersampling (Whitted 1980, with Mitchell's 1987 contrast; englobe-render's
+//!   `supersample`): corners first, cut where they differ, against uniform jittered
+//!   supersampling at 4 and 16 samples, all measured against 64 uniform samples per pixel.
 
 use std::fmt::Write as _;
 use std::path::PathBuf;
 use std::time::Instant;
 
 use englobe::AccelKind;
+use englobe_render::supersample::AdaptiveSupersampling;
 use englobe_render::{RayKind, RenderStats, Renderer};
 use englobe_scene::{IntegratorKind, Scene, load_scene};
 
@@ -36,6 +40,15 @@ pub const DEFAULT_SCENES: [&str; 7] = [
 
 /// The adaptive-depth thresholds measured by default.
 pub const DEFAULT_THRESHOLDS: [f32; 4] = [0.1, 0.03, 0.01, 0.003];
+
+/// Samples per pixel of the anti-aliasing reference.
+pub const REFERENCE_SAMPLES: u32 = 64;
+
+/// Uniform supersampling rates compared with the adaptive one.
+pub const UNIFORM_SAMPLES: [u32; 2] = [4, 16];
+
+/// Adaptive supersampling settings measured: (contrast, maximum level).
+pub const ADAPTIVE_SUPERSAMPLING: [(f32, u32); 3] = [(0.1, 2), (0.05, 3), (0.02, 3)];
 
 /// What to measure.
 #[derive(Clone, Debug)]
@@ -66,9 +79,12 @@ impl Default for FewerRaysOptions {
 pub struct FewerRaysRow {
     /// The scene file.
     pub scene: String,
-    /// `full depth` (the reference) or `adaptive depth`.
+    /// `full depth` (the reference of `adaptive depth`), `adaptive depth`, `uniform, reference`
+    /// (the reference of `uniform` and `adaptive ss`), `uniform` or `adaptive ss` (adaptive
+    /// supersampling).
     pub method: String,
-    /// The setting: the scene's maximum depth, or the threshold.
+    /// The setting: the scene's maximum depth, the threshold, the samples per pixel, or the
+    /// contrast and maximum level.
     pub setting: String,
     /// Rays cast per kind: primary, shadow, reflected, refracted.
     pub rays: [u64; 4],
@@ -106,11 +122,19 @@ pub fn run_fewer_rays(options: &FewerRaysOptions, progress: &mut dyn FnMut(Strin
         scene.image.height = ((h * scale).round() as u32).max(1);
         scene.image.min_contribution = 0.0;
         let (world, _) = build(&scene, AccelKind::BvhWide)?;
-        let render = |scene: &Scene| -> Result<(englobe_render::RenderOutput, f64), LabError> {
+        let render_with = |scene: &Scene,
+                           adaptive: Option<AdaptiveSupersampling>|
+         -> Result<(englobe_render::RenderOutput, f64), LabError> {
             let start = Instant::now();
-            let out = pool.install(|| Renderer::new(scene, &world).count_work(true).render())?;
+            let r = Renderer::new(scene, &world).count_work(true);
+            let r = match adaptive {
+                Some(a) => r.supersampling(a),
+                None => r,
+            };
+            let out = pool.install(|| r.render())?;
             Ok((out, start.elapsed().as_secs_f64()))
         };
+        let render = |scene: &Scene| render_with(scene, None);
         progress(format!("{name}: full depth ({})", scene.image.max_depth));
         let (reference, seconds) = render(&scene)?;
         let row = |method: &str, setting: String, stats: &RenderStats, seconds: f64, error: ImageError| FewerRaysRow {
@@ -133,6 +157,26 @@ pub fn run_fewer_rays(options: &FewerRaysOptions, progress: &mut dyn FnMut(Strin
             let error = image_error(&image.film, &reference.film);
             out.rows.push(row("adaptive depth", format!("{threshold}"), &image.stats, seconds, error));
         }
+
+        let mut uniform = scene.clone();
+        uniform.image.samples = REFERENCE_SAMPLES;
+        progress(format!("{name}: uniform supersampling, {REFERENCE_SAMPLES} samples"));
+        let (reference, seconds) = render(&uniform)?;
+        let exact = image_error(&reference.film, &reference.film);
+        out.rows.push(row("uniform, reference", format!("{REFERENCE_SAMPLES} spp"), &reference.stats, seconds, exact));
+        for samples in UNIFORM_SAMPLES {
+            progress(format!("{name}: uniform supersampling, {samples} samples"));
+            uniform.image.samples = samples;
+            let (image, seconds) = render(&uniform)?;
+            let error = image_error(&image.film, &reference.film);
+            out.rows.push(row("uniform", format!("{samples} spp"), &image.stats, seconds, error));
+        }
+        for (contrast, max_level) in ADAPTIVE_SUPERSAMPLING {
+            progress(format!("{name}: adaptive supersampling, contrast {contrast}, level {max_level}"));
+            let (image, seconds) = render_with(&scene, Some(AdaptiveSupersampling { contrast, max_level }))?;
+            let error = image_error(&image.film, &reference.film);
+            out.rows.push(row("adaptive ss", format!("{contrast}/{max_level}"), &image.stats, seconds, error));
+        }
     }
     Ok(out)
 }
@@ -143,7 +187,7 @@ impl FewerRays {
         let mut s = String::new();
         let _ = writeln!(
             s,
-            "{:<24} {:<15} {:>8} {:>10} {:>10} {:>10} {:>10} {:>13} {:>7} {:>6} {:>7}",
+            "{:<24} {:<18} {:>8} {:>10} {:>10} {:>10} {:>10} {:>13} {:>7} {:>6} {:>7}",
             "scene",
             "method",
             "setting",
@@ -159,7 +203,7 @@ impl FewerRays {
         for r in &self.rows {
             let _ = writeln!(
                 s,
-                "{:<24} {:<15} {:>8} {:>10} {:>10} {:>10} {:>10} {:>13} {:>7.3} {:>6.2} {:>7.4}",
+                "{:<24} {:<18} {:>8} {:>10} {:>10} {:>10} {:>10} {:>13} {:>7.3} {:>6.2} {:>7.4}",
                 r.scene.trim_start_matches("scenes/"),
                 r.method,
                 r.setting,

@@ -24,8 +24,8 @@
 pub mod compare;
 pub mod error;
 pub mod fewer_rays;
-pub mod image_error;
 pub mod html_report;
+pub mod image_error;
 pub mod measure;
 pub mod memory;
 pub mod plot;

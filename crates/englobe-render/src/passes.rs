@@ -27,6 +27,11 @@ impl Renderer<'_> {
     /// [`RenderOutput::complete`] says whether that is all of them. Progress is reported as
     /// `(passes_done, passes_total)`. Work is counted if asked; the cost AOV is not recorded.
     pub fn render_passes(&self, deadline: Option<Instant>) -> Result<RenderOutput, RenderError> {
+        if self.supersampling.is_some() {
+            return Err(RenderError::Limits(
+                "adaptive supersampling has no passes: a pixel's samples depend on each other".into(),
+            ));
+        }
         ImageSettings::check_limits(self.width, self.height, self.samples, self.scene.image.max_depth)
             .map_err(RenderError::Limits)?;
         if let Some(w) = self.window {

@@ -23,6 +23,7 @@ use crate::cost::CostImage;
 use crate::film::Film;
 use crate::path::PathTracer;
 use crate::stats::{RenderStats, Tally};
+use crate::supersample::AdaptiveSupersampling;
 use crate::tile::PixelWindow;
 use crate::whitted::Whitted;
 
@@ -75,6 +76,7 @@ pub struct Renderer<'a> {
     pub(crate) progress: Option<&'a (dyn Fn(usize, usize) + Sync)>,
     pub(crate) cancel: Option<&'a AtomicBool>,
     pub(crate) integrator: IntegratorKind,
+    pub(crate) supersampling: Option<AdaptiveSupersampling>,
 }
 
 impl<'a> Renderer<'a> {
@@ -95,6 +97,7 @@ impl<'a> Renderer<'a> {
             progress: None,
             cancel: None,
             integrator: scene.image.integrator,
+            supersampling: None,
         }
     }
 
@@ -137,6 +140,15 @@ impl<'a> Renderer<'a> {
     /// starts), into a film of the window's size; each has the value a full render gives it.
     pub fn window(mut self, window: PixelWindow) -> Self {
         self.window = Some(window);
+        self
+    }
+
+    /// Samples each pixel adaptively (see [`crate::supersample`]) instead of with the scene's
+    /// samples: corners first, squares whose corners differ cut in four. The sample positions
+    /// are fixed, so a pixel still depends on itself alone; the path tracer's random numbers
+    /// come from the pixel's generator as usual. Not for renders by passes.
+    pub fn supersampling(mut self, adaptive: AdaptiveSupersampling) -> Self {
+        self.supersampling = Some(adaptive);
         self
     }
 
@@ -273,6 +285,10 @@ impl<'a> Renderer<'a> {
         tally: &mut Tally<C>,
     ) -> Vec3 {
         let mut rng = pixel_rng(self.scene.image.seed, x, y);
+        if let Some(adaptive) = self.supersampling {
+            let mut at = |dx: f32, dy: f32| self.sample_at(camera, integrator, x, y, dx, dy, &mut rng, tally);
+            return adaptive.pixel(&mut at).0;
+        }
         if self.samples == 1 {
             return self.sample(camera, integrator, x, y, &mut rng, tally);
         }
@@ -298,6 +314,23 @@ impl<'a> Renderer<'a> {
         tally: &mut Tally<C>,
     ) -> Vec3 {
         let (dx, dy): (f32, f32) = if self.samples == 1 { (0.5, 0.5) } else { (rng.random(), rng.random()) };
+        self.sample_at(camera, integrator, x, y, dx, dy, rng, tally)
+    }
+
+    /// The sample of pixel `(x, y)` through its point `(dx, dy)` (both in `0..=1`).
+    #[inline]
+    #[allow(clippy::too_many_arguments)]
+    fn sample_at<C: Counters>(
+        &self,
+        camera: &ImageCamera,
+        integrator: &Integrator,
+        x: u32,
+        y: u32,
+        dx: f32,
+        dy: f32,
+        rng: &mut Pcg32,
+        tally: &mut Tally<C>,
+    ) -> Vec3 {
         let ray = if camera.has_lens() {
             // Drawn only with a lens, so that pinhole images keep their random numbers.
             let (u, v): (f32, f32) = (rng.random(), rng.random());
