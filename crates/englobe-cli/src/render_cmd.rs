@@ -187,6 +187,9 @@ fn render(args: &RenderArgs, interrupted: &'static std::sync::atomic::AtomicBool
         (None, None) => PathBuf::from(stem).with_extension("png"),
     });
     let format = englobe_render::output::check_writable(&output)?;
+    if let Some(path) = &args.stats_json {
+        englobe_render::output::check_file_writable(path)?;
+    }
     if args.tile.is_some() || args.pixel_bounds.is_some() {
         anyhow::ensure!(
             format == englobe_render::OutputFormat::Exr,

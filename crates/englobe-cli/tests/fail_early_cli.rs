@@ -43,6 +43,20 @@ fn the_destination_is_checked_before_the_render_starts() {
 }
 
 #[test]
+fn the_statistics_file_is_checked_before_the_render_starts() {
+    let dir = tempfile::tempdir().unwrap();
+    let huge = ["--width", "16000", "--height", "16000", "--spp", "4096"];
+    let start = Instant::now();
+    let o = englobe(
+        dir.path(),
+        &[&["render", "missing.toml", "-o", "out.png", "--stats-json", "gone/s.json"][..], &huge].concat(),
+    );
+    assert!(start.elapsed() < Duration::from_secs(20), "the render started");
+    assert_eq!(stderr(&o).trim_end(), "error: gone/s.json: cannot write: the folder gone does not exist");
+    assert!(!dir.path().join("out.png").exists());
+}
+
+#[test]
 fn an_io_error_names_the_destination_and_its_cause_once() {
     let dir = tempfile::tempdir().unwrap();
     let o = englobe(dir.path(), &["render", "--width", "8", "-o", "gone/x.png"]);

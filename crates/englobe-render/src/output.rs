@@ -155,11 +155,22 @@ fn without_path(error: std::io::Error) -> std::io::Error {
 /// that exists, and the right to create a file in it (tried with a file created and removed at
 /// once), so that a long render never ends in "cannot write".
 pub fn check_writable(path: &Path) -> Result<OutputFormat, OutputError> {
+    // A folder is refused as one, before its name is judged as an image's.
+    if path.is_dir() {
+        check_file_writable(path)?;
+    }
+    let format = OutputFormat::from_path(path)?;
+    check_file_writable(path)?;
+    Ok(format)
+}
+
+/// Checks, before any work, that a file (of any kind: an image, statistics) can be written at
+/// `path`: not a folder, in a folder that exists and takes a new file.
+pub fn check_file_writable(path: &Path) -> Result<(), OutputError> {
     let refuse = |message: &str| OutputError::Io { path: path.to_owned(), error: std::io::Error::other(message) };
     if path.is_dir() {
         return Err(refuse("it is a folder"));
     }
-    let format = OutputFormat::from_path(path)?;
     let dir = match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),
@@ -174,7 +185,7 @@ pub fn check_writable(path: &Path) -> Result<OutputFormat, OutputError> {
         .suffix(".tmp")
         .tempfile_in(dir)
         .map_err(|error| OutputError::Io { path: path.to_owned(), error: without_path(error) })?;
-    Ok(format)
+    Ok(())
 }
 
 #[cfg(test)]

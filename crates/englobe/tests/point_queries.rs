@@ -195,3 +195,20 @@ fn worlds_answer_for_their_meshes_whatever_the_structure() {
     }
     assert!(near > 250 && inside > 60, "{near} points, {inside} triangles in boxes");
 }
+
+#[test]
+fn flat_arrays_build_what_arrays_of_triples_build() {
+    let mesh = load_obj("scenes/meshes/bunny/stanford-bunny.obj");
+    let flat_vertices: Vec<f32> = mesh.positions().iter().flat_map(|p| p.to_array()).collect();
+    let flat_indices: Vec<u32> = mesh.triangles().iter().flatten().copied().collect();
+    let triples: Vec<[f32; 3]> = mesh.positions().iter().map(|p| p.to_array()).collect();
+    let from_flat = TriangleBvh::from_flat(&flat_vertices, &flat_indices).unwrap();
+    let from_arrays = TriangleBvh::from_arrays(&triples, mesh.triangles()).unwrap();
+    assert_eq!(from_flat.nodes(), from_arrays.nodes());
+    assert_eq!(from_flat.blocks(), from_arrays.blocks());
+    assert_eq!(TriangleMesh::from_flat(&flat_vertices, &flat_indices).unwrap().triangles(), mesh.triangles());
+    let e = TriangleBvh::from_flat(&flat_vertices[1..], &flat_indices).unwrap_err();
+    assert_eq!(e.to_string(), format!("vertices has {} numbers, not a multiple of 3", flat_vertices.len() - 1));
+    let e = TriangleMesh::from_flat(&flat_vertices, &flat_indices[..4]).unwrap_err();
+    assert_eq!(e.to_string(), "indices has 4 numbers, not a multiple of 3");
+}

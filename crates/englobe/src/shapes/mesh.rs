@@ -42,6 +42,24 @@ pub enum MeshError {
     /// More than `u32::MAX` vertices or triangles.
     #[error("the mesh is too large: {0} elements do not fit 32-bit indices")]
     TooLarge(usize),
+    /// A flat array whose length is not a multiple of three.
+    #[error("{array} has {len} numbers, not a multiple of 3")]
+    FlatLength {
+        /// Which array: `vertices` or `indices`.
+        array: &'static str,
+        /// Its length.
+        len: usize,
+    },
+}
+
+/// A flat array of numbers seen as an array of triples, without a copy.
+pub(crate) fn triples<'a, T: Copy>(flat: &'a [T], array: &'static str) -> Result<&'a [[T; 3]], MeshError> {
+    if flat.len() % 3 != 0 {
+        return Err(MeshError::FlatLength { array, len: flat.len() });
+    }
+    // SAFETY: `[T; 3]` is three `T` in a row, with `T`'s alignment (the array layout Rust
+    // guarantees), and `flat` holds `len / 3` such triples in its memory.
+    Ok(unsafe { std::slice::from_raw_parts(flat.as_ptr() as *const [T; 3], flat.len() / 3) })
 }
 
 /// Checks vertex positions and triangles: sizes that fit 32-bit indices, finite coordinates,
@@ -112,6 +130,22 @@ impl TriangleMesh {
             normals: None,
             uvs: None,
         })
+    }
+
+    /// [`TriangleMesh::from_arrays`] from flat arrays, as graphics APIs and file formats hand
+    /// them out: `x, y, z` of each vertex in turn, and three indices per triangle. A length that
+    /// is not a multiple of three is an error.
+    ///
+    /// ```
+    /// use englobe::TriangleMesh;
+    ///
+    /// let mesh = TriangleMesh::from_flat(&[0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0], &[0, 1, 2])?;
+    /// assert_eq!(mesh.len(), 1);
+    /// assert!(TriangleMesh::from_flat(&[0.0, 0.0], &[]).is_err());
+    /// # Ok::<(), englobe::shapes::MeshError>(())
+    /// ```
+    pub fn from_flat(vertices: &[f32], indices: &[u32]) -> Result<Self, MeshError> {
+        Self::from_arrays(triples(vertices, "vertices")?, triples(indices, "indices")?)
     }
 
     /// Adds per-vertex normals (one per vertex; normalised when used).

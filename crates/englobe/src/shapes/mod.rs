@@ -17,6 +17,7 @@ pub use aabox::AaBox;
 pub use clip::clip_triangle;
 pub use closest_point::{closest_point_on_triangle, distance_squared, distance_squared_to_box};
 pub use instance::{Instance, InstanceError, transform_box};
+pub(crate) use mesh::triples;
 pub use mesh::{MeshError, TriangleMesh, check_arrays};
 pub use plane::Plane;
 pub use sphere::Sphere;

@@ -130,6 +130,12 @@ impl TriangleBvh {
         Ok(Self::build_with(triangles.len(), triangle_of(vertices, triangles), TriangleBvhOptions::default()))
     }
 
+    /// [`TriangleBvh::from_arrays`] from flat arrays: `x, y, z` of each vertex in turn and three
+    /// indices per triangle, read in place (see [`TriangleMesh::from_flat`]).
+    pub fn from_flat(vertices: &[f32], indices: &[u32]) -> Result<Self, MeshError> {
+        Self::from_arrays(crate::shapes::triples(vertices, "vertices")?, crate::shapes::triples(indices, "indices")?)
+    }
+
     /// Builds the structure over `count` triangles, triangle `i` given by `triangle(i)`, at most
     /// [`MAX_PRIMITIVES`] of them. Zero-area triangles are left out (they are never hit), and so
     /// are triangles with non-finite coordinates.
