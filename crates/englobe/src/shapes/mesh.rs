@@ -54,7 +54,7 @@ pub enum MeshError {
 
 /// A flat array of numbers seen as an array of triples, without a copy.
 pub(crate) fn triples<'a, T: Copy>(flat: &'a [T], array: &'static str) -> Result<&'a [[T; 3]], MeshError> {
-    if flat.len() % 3 != 0 {
+    if !flat.len().is_multiple_of(3) {
         return Err(MeshError::FlatLength { array, len: flat.len() });
     }
     // SAFETY: `[T; 3]` is three `T` in a row, with `T`'s alignment (the array layout Rust
