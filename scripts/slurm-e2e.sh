@@ -27,7 +27,7 @@ OPTS=(--width 128 --height 96 --spp 512)
 
 START=$(date +%s.%N)
 elapsed() { python3 -c "import sys; print(f'{float(sys.argv[2]) - float(sys.argv[1]):.1f}')" "$START" "$(date +%s.%N)"; }
-D=$(mktemp -d /tmp/englobe-slurm.XXXXXX)
+D=$(mktemp -d -t englobe-slurm.XXXXXX)
 PIDFILES=("$D/slurmd.pid" "$D/slurmctld.pid" "$D/munge/munged.pid")
 cleanup() {
     status=$?

@@ -184,7 +184,8 @@ fn run_slurm(args: SlurmArgs) -> anyhow::Result<ExitCode> {
     });
     let plan =
         Plan { dir, digest: render_digest(&scene, args.image.accel, args.balance), width, height, count: args.tiles };
-    let earlier_run = plan.jobs_file().exists() || plan.survey().is_ok_and(|(done, _)| !done.is_empty());
+    // A look at the names only: the tiles themselves are read once the queue is clear.
+    let earlier_run = plan.jobs_file().exists() || (0..plan.count).any(|k| plan.tile_path(k).exists());
     if args.resume && !earlier_run {
         bail!("{}: no earlier run to resume (no tiles, no jobs file)", plan.dir.display());
     }

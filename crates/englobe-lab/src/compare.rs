@@ -234,7 +234,13 @@ impl Comparison {
 
     /// Draws rays per second and exact tests per ray of every structure into the SVG file `path`.
     pub fn write_plot(&self, path: &Path) -> Result<(), LabError> {
-        let plotted: Vec<PlotRow> = self
+        let (rows, subtitle) = self.plot();
+        write_svg(path, &self.scene, &subtitle, &rows)
+    }
+
+    /// What the plot draws: a row per structure, and the subtitle that says what was measured.
+    pub(crate) fn plot(&self) -> (Vec<PlotRow>, String) {
+        let rows = self
             .rows
             .iter()
             .map(|r| PlotRow {
@@ -245,9 +251,7 @@ impl Comparison {
             .collect();
         let (primitives, width, height, samples, threads) =
             (self.primitives, self.width, self.height, self.samples, self.threads);
-        let subtitle =
-            format!("{primitives} primitives, {width}x{height}, {samples} sample(s) per pixel, {threads} threads");
-        write_svg(path, &self.scene, &subtitle, &plotted)
+        (rows, format!("{primitives} primitives, {width}x{height}, {samples} sample(s) per pixel, {threads} threads"))
     }
 }
 

@@ -19,7 +19,7 @@ use englobe_scene::Scene;
 use crate::compare::Comparison;
 use crate::error::LabError;
 use crate::measure::{RenderSettings, build, render};
-use crate::plot::{PlotRow, svg};
+use crate::plot::svg;
 
 /// Width of the pictures on the page, in pixels (the height follows the scene's aspect ratio).
 pub const PREVIEW_WIDTH: u32 = 320;
@@ -150,19 +150,7 @@ pub fn report_page(comparison: &Comparison, pictures: &ReportPictures) -> String
         );
     }
     let _ = writeln!(p, "</table>\n<h2>Rays per second and exact tests per ray</h2>");
-    let rows: Vec<PlotRow> = c
-        .rows
-        .iter()
-        .map(|r| PlotRow {
-            name: r.accel.to_owned(),
-            rays_per_second: r.rays_per_second,
-            exact_tests_per_ray: r.exact_tests_per_ray,
-        })
-        .collect();
-    let subtitle = format!(
-        "{} primitives, {}x{}, {} sample(s) per pixel, {} threads",
-        c.primitives, c.width, c.height, c.samples, c.threads
-    );
+    let (rows, subtitle) = c.plot();
     let plot = svg(&c.scene, &subtitle, &rows);
     // Inline SVG: the XML declaration, if any, belongs to a file, not to a page.
     p += plot.trim_start_matches(|ch| ch != '<').split_once("?>").map_or(plot.as_str(), |(_, rest)| rest);
