@@ -9,7 +9,7 @@ use englobe::{AccelKind, Object, Ray, Sphere, TriangleMesh, Vec3, World};
 #[path = "common/counting_alloc.rs"]
 mod counting_alloc;
 
-use counting_alloc::allocations_during;
+use counting_alloc::{all_allocations_during, allocations_during};
 
 #[global_allocator]
 static GLOBAL: counting_alloc::Counting = counting_alloc::Counting;
@@ -44,7 +44,7 @@ fn batches_allocate_nothing_per_ray() {
     let (mut hits, mut mask) = (vec![None; rays.len()], vec![false; rays.len()]);
     // The first parallel batch starts the thread pool.
     world.closest_hits(&rays, &mut hits).unwrap();
-    let large = allocations_during(|| {
+    let large = all_allocations_during(|| {
         world.closest_hits(&rays, &mut hits).unwrap();
         world.any_hits(&rays, &mut mask).unwrap();
     });
