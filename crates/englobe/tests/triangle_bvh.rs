@@ -233,3 +233,67 @@ fn stanford_bunny_in_every_instruction_set() {
     let brute_tests = (tris.len() * rays.len()) as u64;
     assert!(counts.exact_tests * 500 < brute_tests, "{} exact tests, brute force {brute_tests}", counts.exact_tests);
 }
+
+/// Long diagonal struts among small triangles: the build cuts the struts into pieces that lie in
+/// several leaves (see `englobe::accel::wide::presplit`). The structure stays valid, every query
+/// stays brute force's, and the box query still lists each triangle once.
+#[test]
+fn cut_triangles_are_found_once_and_exactly() {
+    use englobe::Aabb;
+    use englobe::accel::Validate;
+    use englobe::accel::wide::TriangleBvhOptions;
+    use englobe::shapes::triangle_overlaps_box;
+
+    let mut rng = seeded(41);
+    let mut tris: Vec<[Vec3; 3]> = (0..400)
+        .map(|_| {
+            let c = in_cube(&mut rng) * 4.0;
+            [c, c + in_cube(&mut rng) * 0.05, c + in_cube(&mut rng) * 0.05]
+        })
+        .collect();
+    for _ in 0..30 {
+        let (a, b) = (in_cube(&mut rng) * 4.0, in_cube(&mut rng) * 4.0);
+        tris.push([a, b, b + in_cube(&mut rng) * 0.1]);
+    }
+    let bvh = TriangleBvh::from_triangles(&tris);
+    let boxes: Vec<Aabb> = tris.iter().map(|t| Aabb::from_points(*t)).collect();
+    let stats = bvh.validate(&boxes, None).expect("a valid structure");
+    assert!(
+        stats.prim_refs > tris.len() + 20,
+        "{} references for {} triangles: nothing was cut",
+        stats.prim_refs,
+        tris.len()
+    );
+    let whole = TriangleBvh::build_with(
+        tris.len(),
+        |i| tris[i as usize],
+        TriangleBvhOptions { presplit_percent: 0, ..Default::default() },
+    );
+    assert_eq!(whole.stats().prim_refs, tris.len());
+
+    // Rays at random, and rays aimed at points of the struts (crossing the cuts).
+    let bounds = boxes.iter().fold(Aabb::EMPTY, |b, t| b.union(t));
+    let mut rays: Vec<Ray> = (0..400).map(|_| ray_into_box(&mut rng, &bounds)).collect();
+    for t in &tris[400..] {
+        for k in 0..10 {
+            let s = k as f32 / 9.0;
+            let target = t[0] + (t[1] - t[0]) * s + (t[2] - t[1]) * (0.5 * s);
+            let origin = in_box(&mut rng, &bounds) * 1.5;
+            rays.push(Ray::new(origin, target - origin));
+        }
+    }
+    let hits = check(&tris, &rays).expect("agreement with brute force");
+    assert!(hits > 300, "{hits} hits");
+
+    for _ in 0..50 {
+        let (a, b) = (in_box(&mut rng, &bounds), in_box(&mut rng, &bounds));
+        let query = Aabb::new(a.min(b), a.max(b));
+        let expected: Vec<u32> =
+            (0..tris.len() as u32).filter(|&i| triangle_overlaps_box(tris[i as usize], &query)).collect();
+        assert_eq!(bvh.triangles_in_box(&query), expected);
+        let mut listed = Vec::new();
+        bvh.for_each_triangle_in_box(&query, |t| listed.push(t));
+        listed.sort_unstable();
+        assert_eq!(listed, expected, "a triangle listed twice or missed");
+    }
+}

@@ -61,15 +61,69 @@ pub fn clip_triangle(v: [Vec3; 3], cell: &Aabb) -> Aabb {
     rounded.intersection(&common)
 }
 
+/// Room for a [`Polygon`]'s vertices: [`MAX_VERTICES`] and a margin for vertices that rounding
+/// would leave doubled.
+const POLYGON_ROOM: usize = 2 * MAX_VERTICES;
+
+/// The part of a triangle inside a box, kept as a convex polygon (at most [`MAX_VERTICES`]
+/// vertices: the triangle cut by at most six planes), so that it can be cut again by one plane
+/// at a time: what cutting a triangle into pieces needs (see
+/// [`crate::accel::wide::presplit`]).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Polygon {
+    vertices: [DVec3; POLYGON_ROOM],
+    len: usize,
+}
+
+impl Polygon {
+    /// The whole triangle.
+    pub(crate) fn triangle(v: [Vec3; 3]) -> Self {
+        let mut vertices = [DVec3::ZERO; POLYGON_ROOM];
+        for (p, q) in vertices.iter_mut().zip(v) {
+            *p = q.as_dvec3();
+        }
+        Polygon { vertices, len: 3 }
+    }
+
+    /// The parts of the polygon below and above the plane `x[axis] = plane` (boundaries
+    /// included); a side may be empty. The polygon must lie inside a box whose planes include
+    /// every plane it was cut by, which bounds its vertices.
+    pub(crate) fn split(&self, axis: usize, plane: f64) -> (Polygon, Polygon) {
+        let poly = &self.vertices[..self.len];
+        let mut below = Polygon { vertices: [DVec3::ZERO; POLYGON_ROOM], len: 0 };
+        let mut above = below;
+        below.len = clip_against(poly, &mut below.vertices, axis, plane, -1.0);
+        above.len = clip_against(poly, &mut above.vertices, axis, plane, 1.0);
+        (below, above)
+    }
+
+    /// The polygon's bounds rounded outward to `f32` ([`Aabb::EMPTY`] if it is empty).
+    pub(crate) fn bounds(&self) -> Aabb {
+        let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+        for p in &self.vertices[..self.len] {
+            lo = lo.min(*p);
+            hi = hi.max(*p);
+        }
+        if self.len == 0 {
+            return Aabb::EMPTY;
+        }
+        Aabb::new(
+            Vec3::new(round_down(lo.x), round_down(lo.y), round_down(lo.z)),
+            Vec3::new(round_up(hi.x), round_up(hi.y), round_up(hi.z)),
+        )
+    }
+}
+
 /// One step of Sutherland and Hodgman: the part of the closed polygon `poly` on the side
 /// `sign * (x[axis] - plane) >= 0`, written to `out`; returns its number of vertices.
-fn clip_against(poly: &[DVec3], out: &mut [DVec3; MAX_VERTICES], axis: usize, plane: f64, sign: f64) -> usize {
+fn clip_against(poly: &[DVec3], out: &mut [DVec3], axis: usize, plane: f64, sign: f64) -> usize {
     let mut len = 0;
     let inside = |p: &DVec3| sign * (p[axis] - plane) >= 0.0;
     for (i, p) in poly.iter().enumerate() {
         let q = &poly[(i + 1) % poly.len()];
         let (p_in, q_in) = (inside(p), inside(q));
-        if p_in {
+        // A convex polygon cut by a plane gains at most one vertex; `out` has room for that.
+        if p_in && len < out.len() {
             out[len] = *p;
             len += 1;
         }
@@ -78,8 +132,10 @@ fn clip_against(poly: &[DVec3], out: &mut [DVec3; MAX_VERTICES], axis: usize, pl
             let s = (plane - p[axis]) / (q[axis] - p[axis]);
             let mut x = *p + (*q - *p) * s;
             x[axis] = plane;
-            out[len] = x;
-            len += 1;
+            if len < out.len() {
+                out[len] = x;
+                len += 1;
+            }
         }
     }
     len

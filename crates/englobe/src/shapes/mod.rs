@@ -3,7 +3,7 @@
 //! of meshes.
 
 mod aabox;
-mod clip;
+pub(crate) mod clip;
 mod closest_point;
 mod instance;
 mod interface;

@@ -22,7 +22,21 @@ fn boxes_overlap(a: &Aabb, b: &Aabb) -> bool {
 impl TriangleBvh {
     /// Calls `found(triangle)` for every stored triangle that overlaps `query` (boundaries
     /// included), in no particular order, each once.
-    pub fn for_each_triangle_in_box(&self, query: &Aabb, mut found: impl FnMut(u32)) {
+    pub fn for_each_triangle_in_box(&self, query: &Aabb, found: impl FnMut(u32)) {
+        if self.cut {
+            // A cut triangle may be met in several leaves: gathered, then reported once each.
+            let mut all = Vec::new();
+            self.walk_box(query, |t| all.push(t));
+            all.sort_unstable();
+            all.dedup();
+            all.into_iter().for_each(found);
+        } else {
+            self.walk_box(query, found);
+        }
+    }
+
+    /// Calls `found` for every triangle overlapping `query` in every leaf that holds it.
+    fn walk_box(&self, query: &Aabb, mut found: impl FnMut(u32)) {
         if self.nodes.is_empty() || !boxes_overlap(&self.bounds, query) {
             return;
         }

@@ -19,7 +19,7 @@
 //!   children for each; `dispatch` (inside the crate): the per-query choice.
 //! * [`traverse`]: the single-ray traversal, generic over kernels and leaves.
 //! * [`triangles`]: blocks of four triangles and their SIMD watertight test; [`triangle_bvh`]:
-//!   [`TriangleBvh`].
+//!   [`TriangleBvh`]; [`presplit`]: the large triangles cut before its build.
 //! * [`point_query`]: the closest point of the triangles to a point; [`box_query`]: the
 //!   triangles overlapping a box.
 //! * [`refit`]: the boxes recomputed after the triangles moved, and the SAH cost that says when
@@ -35,6 +35,7 @@ pub mod isa;
 pub mod kernels;
 pub mod node;
 pub mod point_query;
+pub mod presplit;
 pub mod refit;
 pub mod traverse;
 pub mod triangle_bvh;

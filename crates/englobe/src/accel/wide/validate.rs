@@ -3,13 +3,15 @@
 //! recorded depth the real one; then per leaf, every primitive inside its leaf's box and listed
 //! once. [`WideBvh`] must list every primitive; [`TriangleBvh`] every triangle it says it stored
 //! (it leaves out the zero-area ones, which are never hit), each in a block lane whose vertices
-//! have the triangle's box.
+//! have the triangle's box, in leaves that together cover the triangle (a triangle cut before
+//! the build lies in several).
 
 use super::node::{EMPTY, WIDTH, WideNode, index_of, is_leaf};
 use super::triangles::UNUSED;
 use super::{TriangleBvh, WideBvh};
 use crate::Aabb;
 use crate::accel::{Accel, ClipFn, InvalidStructure, StructureStats, Validate};
+use crate::shapes::clip_triangle;
 
 /// A broken invariant of a wide BVH.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
@@ -88,10 +90,16 @@ impl Validate for WideBvh {
 }
 
 impl Validate for TriangleBvh {
-    /// `prim_boxes[i]` is the box of triangle `i`.
+    /// `prim_boxes[i]` is the box of triangle `i`. A triangle cut before the build (see
+    /// [`super::presplit`]) may lie in several leaves, each holding part of it: each such leaf
+    /// must meet the triangle, and the parts of the triangle inside its leaves must together
+    /// cover the whole triangle's box.
     fn validate(&self, prim_boxes: &[Aabb], _clip: Option<ClipFn<'_>>) -> Result<StructureStats, InvalidStructure> {
         let (blocks, stats) = (self.blocks(), self.stats());
+        let mut covered = vec![Aabb::EMPTY; prim_boxes.len()];
+        let mut refs = 0;
         let checked = walk(self.nodes(), self.bounds(), self.depth(), prim_boxes.len(), |b, first, count, seen| {
+            let mut in_leaf = Vec::new();
             for block in blocks.get(first..first + count).ok_or("bad leaf range")? {
                 if block.used() == 0 {
                     return Err("a block with no triangle".to_owned());
@@ -101,22 +109,37 @@ impl Validate for TriangleBvh {
                     if id == UNUSED {
                         return Err(format!("lane {lane} is unused but counted"));
                     }
-                    mark(id, b, prim_boxes, seen)?;
-                    if Aabb::from_points(block.vertices(lane)) != prim_boxes[id as usize] {
+                    let own = prim_boxes.get(id as usize).ok_or(format!("triangle {id} does not exist"))?;
+                    if Aabb::from_points(block.vertices(lane)) != *own {
                         return Err(format!("triangle {id} is stored with other vertices"));
                     }
+                    let part = clip_triangle(block.vertices(lane), b);
+                    if part.is_empty() {
+                        return Err(format!("triangle {id} does not meet its leaf"));
+                    }
+                    covered[id as usize] = covered[id as usize].union(&part);
+                    seen[id as usize] += 1;
+                    in_leaf.push(id);
+                    refs += 1;
                 }
             }
-            Ok(())
+            in_leaf.sort_unstable();
+            match in_leaf.windows(2).find(|w| w[0] == w[1]) {
+                Some(w) => Err(format!("triangle {} is twice in one leaf", w[0])),
+                None => Ok(()),
+            }
         })
         .and_then(|seen| {
-            if let Some(p) = seen.iter().position(|&s| s > 1) {
-                return Err(format!("triangle {p} is in {} leaves", seen[p]));
+            if let Some(p) = (0..seen.len()).find(|&p| seen[p] > 0 && !covered[p].contains_box(&prim_boxes[p])) {
+                return Err(format!("the leaves holding triangle {p} do not cover it"));
             }
-            let stored = seen.iter().filter(|&&s| s == 1).count();
-            match stored == stats.prim_refs {
+            let stored = seen.iter().filter(|&&s| s > 0).count();
+            if stored != self.stored {
+                return Err(format!("{stored} triangles in the leaves, {} recorded", self.stored));
+            }
+            match refs == stats.prim_refs {
                 true => Ok(()),
-                false => Err(format!("{stored} triangles in the leaves, {} recorded", stats.prim_refs)),
+                false => Err(format!("{refs} references in the leaves, {} counted", stats.prim_refs)),
             }
         });
         checked.map_err(|e| InvalidStructure::new("triangle BVH", WideBvhError(e)))?;
