@@ -19,7 +19,7 @@
 
 use englobe::{Vec2, Vec3};
 
-use super::fresnel::fresnel_dielectric;
+use super::fresnel::{fresnel_dielectric, fresnel_dielectric_cosines};
 use super::local::{abs_cos_theta, reflect, refract, same_hemisphere};
 use super::microfacet::TrowbridgeReitz;
 use super::sample::{BsdfSample, SampleKind};
@@ -58,7 +58,7 @@ impl Dielectric {
         }
         let Some(h) = self.generalized_half(wo, wi) else { return Vec3::ZERO };
         let (cos_o, cos_i) = (wo.z, wi.z);
-        let r = fresnel_dielectric(wo.dot(h.wm), self.eta);
+        let r = h.reflectance(wo, wi, self.eta);
         let d_g = self.distribution.d(h.wm) * self.distribution.g2(wo, wi);
         if h.reflect {
             return Vec3::splat(d_g * r / (4.0 * cos_i * cos_o).abs());
@@ -75,7 +75,7 @@ impl Dielectric {
             return 0.0;
         }
         let Some(h) = self.generalized_half(wo, wi) else { return 0.0 };
-        let (pr, pt) = self.lobe_probabilities(fresnel_dielectric(wo.dot(h.wm), self.eta));
+        let (pr, pt) = self.lobe_probabilities(h.reflectance(wo, wi, self.eta));
         let visible = self.distribution.d_visible(wo, h.wm);
         if h.reflect {
             pr * visible / (4.0 * wo.dot(h.wm).abs())
@@ -176,6 +176,18 @@ struct Half {
     reflect: bool,
     /// `n_i / n_o`, 1 for a reflection.
     etap: f32,
+}
+
+impl Half {
+    /// The Fresnel reflectance at this microfacet: for a refraction, from both directions'
+    /// cosines, which keeps `1 - F` accurate near the critical angle and the same both ways.
+    fn reflectance(&self, wo: Vec3, wi: Vec3, eta: f32) -> f32 {
+        if self.reflect {
+            fresnel_dielectric(wo.dot(self.wm), eta)
+        } else {
+            fresnel_dielectric_cosines(wo.dot(self.wm).abs(), wi.dot(self.wm).abs(), self.etap)
+        }
+    }
 }
 
 /// The mean of the three channels.

@@ -31,6 +31,19 @@ pub fn fresnel_dielectric(cos_i: f32, eta: f32) -> f32 {
     (0.5 * (r_parallel * r_parallel + r_perpendicular * r_perpendicular)).clamp(0.0, 1.0)
 }
 
+/// Reflectance of a dielectric boundary from both cosines of a refraction: `cos_i` on the
+/// incident side and `cos_t` on the transmitted side (both non-negative), `eta = n_t / n_i`.
+/// The same value as [`fresnel_dielectric`], but with no square root: near the critical angle,
+/// where `cos_t` computed from `cos_i` loses every digit, this form stays exact when both
+/// cosines are known (a refraction through a known microfacet), and it is the same for the path
+/// and its reverse.
+#[inline]
+pub fn fresnel_dielectric_cosines(cos_i: f32, cos_t: f32, eta: f32) -> f32 {
+    let r_parallel = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
+    let r_perpendicular = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
+    (0.5 * (r_parallel * r_parallel + r_perpendicular * r_perpendicular)).clamp(0.0, 1.0)
+}
+
 /// A complex number, only as wide as the conductor's Fresnel equations need.
 #[derive(Clone, Copy, Debug)]
 struct Complex {
@@ -93,7 +106,11 @@ pub fn fresnel_complex(cos_i: f32, eta: f32, k: f32) -> f32 {
 
 /// [`fresnel_complex`] per colour channel.
 pub fn fresnel_complex_rgb(cos_i: f32, eta: Vec3, k: Vec3) -> Vec3 {
-    Vec3::new(fresnel_complex(cos_i, eta.x, k.x), fresnel_complex(cos_i, eta.y, k.y), fresnel_complex(cos_i, eta.z, k.z))
+    Vec3::new(
+        fresnel_complex(cos_i, eta.x, k.x),
+        fresnel_complex(cos_i, eta.y, k.y),
+        fresnel_complex(cos_i, eta.z, k.z),
+    )
 }
 
 /// `(1 - |cos θ|)^5`, the weight of `1 - F0` in Schlick's approximation.
@@ -152,6 +169,17 @@ mod tests {
             let ct = (1.0 - sin_t * sin_t).sqrt();
             let (outside, inside) = (fresnel_dielectric(ci, 1.5), fresnel_dielectric(-ct, 1.5));
             assert!((outside - inside).abs() < 1e-5, "{deg}: {outside} {inside}");
+        }
+    }
+
+    #[test]
+    fn both_cosines_give_the_same_reflectance_both_ways() {
+        for deg in [0.0f32, 30.0, 41.0, 60.0, 89.0] {
+            let ci = deg.to_radians().cos();
+            let ct = (1.0 - (1.0 - ci * ci) / 2.25).sqrt();
+            let r = fresnel_dielectric_cosines(ci, ct, 1.5);
+            assert!((r - fresnel_dielectric(ci, 1.5)).abs() < 1e-6, "{deg}");
+            assert!((r - fresnel_dielectric_cosines(ct, ci, 1.0 / 1.5)).abs() < 1e-7, "{deg}");
         }
     }
 

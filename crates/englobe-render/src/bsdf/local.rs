@@ -1,51 +1,13 @@
-//! Spherical trigonometry of unit directions in the local shading frame (`z` the normal), and
-//! the mirror and Snell directions there. The formulas are those of Pharr, Jakob and Humphreys,
+//! Unit directions in the local shading frame (`z` the normal): their side of the surface, and
+//! the mirror and Snell directions. The formulas are those of Pharr, Jakob and Humphreys,
 //! "Physically Based Rendering", 4th edition, sections 3.8.3 and 9.3-9.5.
 
 use englobe::Vec3;
-
-/// `cos θ` of a local direction.
-#[inline]
-pub fn cos_theta(w: Vec3) -> f32 {
-    w.z
-}
 
 /// `|cos θ|` of a local direction.
 #[inline]
 pub fn abs_cos_theta(w: Vec3) -> f32 {
     w.z.abs()
-}
-
-/// `cos² θ` of a local direction.
-#[inline]
-pub fn cos2_theta(w: Vec3) -> f32 {
-    w.z * w.z
-}
-
-/// `sin² θ`, never negative.
-#[inline]
-pub fn sin2_theta(w: Vec3) -> f32 {
-    (1.0 - cos2_theta(w)).max(0.0)
-}
-
-/// `tan² θ`: infinite on the horizon.
-#[inline]
-pub fn tan2_theta(w: Vec3) -> f32 {
-    sin2_theta(w) / cos2_theta(w)
-}
-
-/// `cos φ`, and 1 at the poles where `φ` is undefined.
-#[inline]
-pub fn cos_phi(w: Vec3) -> f32 {
-    let sin_theta = sin2_theta(w).sqrt();
-    if sin_theta == 0.0 { 1.0 } else { (w.x / sin_theta).clamp(-1.0, 1.0) }
-}
-
-/// `sin φ`, and 0 at the poles.
-#[inline]
-pub fn sin_phi(w: Vec3) -> f32 {
-    let sin_theta = sin2_theta(w).sqrt();
-    if sin_theta == 0.0 { 0.0 } else { (w.y / sin_theta).clamp(-1.0, 1.0) }
 }
 
 /// True if both directions lie strictly on the same side of the surface.
@@ -89,17 +51,6 @@ mod tests {
     fn dir(theta_deg: f32, phi_deg: f32) -> Vec3 {
         let (t, p) = (theta_deg.to_radians(), phi_deg.to_radians());
         Vec3::new(t.sin() * p.cos(), t.sin() * p.sin(), t.cos())
-    }
-
-    #[test]
-    fn angles_come_back() {
-        let w = dir(30.0, 120.0);
-        assert!((cos_theta(w) - 30f32.to_radians().cos()).abs() < 1e-6);
-        assert!((tan2_theta(w) - 30f32.to_radians().tan().powi(2)).abs() < 1e-5);
-        assert!((cos_phi(w) - 120f32.to_radians().cos()).abs() < 1e-5);
-        assert!((sin_phi(w) - 120f32.to_radians().sin()).abs() < 1e-5);
-        assert_eq!((cos_phi(Vec3::Z), sin_phi(Vec3::Z)), (1.0, 0.0));
-        assert!(tan2_theta(Vec3::X).is_infinite());
     }
 
     #[test]

@@ -25,7 +25,7 @@ use std::f32::consts::PI;
 
 use englobe::{Vec2, Vec3};
 
-use super::local::{abs_cos_theta, cos2_theta, cos_phi, sin_phi, tan2_theta};
+use super::local::abs_cos_theta;
 
 /// Below this `alpha` (on both axes) a surface is smooth: a mirror or a perfect refractor
 /// (pbrt-v4's threshold).
@@ -76,32 +76,29 @@ impl TrowbridgeReitz {
 
     /// The density of microfacet normals `D(m)` per unit solid angle of `m`, normalised so that
     /// `∫ D(m) cos θm dm = 1` over the upper hemisphere. Zero below the horizon.
+    ///
+    /// Written as `1 / (π αx αy (x²/αx² + y²/αy² + z²)²)` for the unit `m = (x, y, z)`, which
+    /// equals the textbook `1 / (π αx αy cos⁴θ (1 + tan²θ (cos²φ/αx² + sin²φ/αy²))²)` but needs no
+    /// cut-off near the horizon, where that form divides by `cos⁴θ → 0`.
     pub fn d(&self, wm: Vec3) -> f32 {
         if wm.z <= 0.0 {
             return 0.0;
         }
-        let tan2 = tan2_theta(wm);
-        if tan2.is_infinite() {
-            return 0.0;
-        }
-        let cos4 = cos2_theta(wm) * cos2_theta(wm);
-        if cos4 < 1e-16 {
-            return 0.0;
-        }
-        let (cp, sp) = (cos_phi(wm) / self.alpha_x, sin_phi(wm) / self.alpha_y);
-        let e = tan2 * (cp * cp + sp * sp);
-        1.0 / (PI * self.alpha_x * self.alpha_y * cos4 * (1.0 + e) * (1.0 + e))
+        let (x, y) = (wm.x / self.alpha_x, wm.y / self.alpha_y);
+        let t = x * x + y * y + wm.z * wm.z;
+        1.0 / (PI * self.alpha_x * self.alpha_y * t * t)
     }
 
-    /// Smith's auxiliary function `Λ(w)` (Heitz 2014, equation 86); the same for `w` and `-w`.
+    /// Smith's auxiliary function `Λ(w) = (sqrt(1 + α(φ)² tan²θ) - 1) / 2` (Heitz 2014,
+    /// equation 86), with `α(φ)² tan²θ = (αx² x² + αy² y²) / z²`; the same for `w` and `-w`,
+    /// infinite on the horizon.
     pub fn lambda(&self, w: Vec3) -> f32 {
-        let tan2 = tan2_theta(w);
-        if tan2.is_infinite() {
+        if w.z == 0.0 {
             return f32::INFINITY;
         }
-        let (cx, sy) = (cos_phi(w) * self.alpha_x, sin_phi(w) * self.alpha_y);
-        let alpha2 = cx * cx + sy * sy;
-        0.5 * ((1.0 + alpha2 * tan2).sqrt() - 1.0)
+        let (x, y) = (self.alpha_x * w.x, self.alpha_y * w.y);
+        let alpha2_tan2 = (x * x + y * y) / (w.z * w.z);
+        0.5 * ((1.0 + alpha2_tan2).sqrt() - 1.0)
     }
 
     /// Smith's masking `G1(w) = 1 / (1 + Λ(w))`: the fraction of the microsurface seen from `w`.

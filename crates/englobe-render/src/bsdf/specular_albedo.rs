@@ -5,10 +5,11 @@
 //! With Schlick's `F = F0 + (1 - F0) s`, `s = (1 - |wo·m|)^5`, the albedo of the microfacet lobe
 //! `E(μ, α, F0) = ∫ F D G2 / (4 |cos θo| |cos θi|) |cos θi| dwi` is linear in `F0`:
 //! `E = F0 A(μ, α) + (1 - F0) B(μ, α)`, with `A` the albedo without Fresnel and `B` the albedo
-//! weighted by `s`. Both are tabulated over `μ = |cos θo|` and the perceptual roughness
-//! `sqrt(α)` on a uniform grid, and read back bilinearly; their cosine-weighted hemispherical
-//! means `Ā = 2 ∫ A μ dμ` are integrated exactly over the piecewise-linear interpolant, so that
-//! a layer normalised by `1 - Ē` reflects exactly what its table says. This is the precomputed
+//! weighted by `s`. Both are tabulated on a uniform grid over `sqrt(μ)`, `μ = |cos θo|` (dense
+//! toward grazing angles, where a smooth layer's albedo changes fastest), and the perceptual
+//! roughness `sqrt(α)`, and read back bilinearly; their cosine-weighted hemispherical means
+//! `Ā = 2 ∫ A μ dμ` are integrated exactly over the interpolant, so that a layer normalised by
+//! `1 - Ē` reflects exactly what its table says. This is the precomputed
 //! albedo of Kelemen and Szirmay-Kalos (2001), "A Microfacet Based Coupled Specular-Matte BRDF
 //! Model with Importance Sampling", as Kulla and Conty (2017), "Revisiting Physically Based
 //! Shading at Imageworks" (SIGGRAPH course) use it to layer a diffuse base under a specular one.
@@ -25,8 +26,8 @@ use super::fresnel::schlick_weight;
 use super::local::reflect;
 use super::microfacet::{SMOOTH_ALPHA, TrowbridgeReitz};
 
-/// Grid points along `μ = |cos θo|`, from 0 to 1.
-const MU_POINTS: usize = 32;
+/// Grid points along `sqrt(μ)`, `μ = |cos θo|`, from 0 to 1.
+const MU_POINTS: usize = 64;
 /// Grid points along the perceptual roughness `sqrt(α)`, from 0 to 1.
 const ROUGHNESS_POINTS: usize = 32;
 /// Strata per axis of the visible-normal samples of one entry.
@@ -53,13 +54,15 @@ fn build() -> Tables {
         let alpha = roughness * roughness;
         for mi in 0..MU_POINTS {
             // The grazing column is the limit: taken just above the horizon.
-            let mu = (mi as f32 / (MU_POINTS - 1) as f32).max(1e-4);
+            let s = mi as f32 / (MU_POINTS - 1) as f32;
+            let mu = (s * s).max(1e-6);
             let (ea, eb) = if alpha < SMOOTH_ALPHA { (1.0, schlick_weight(mu)) } else { integrate(mu, alpha) };
             a.push(ea);
             b.push(eb);
         }
     }
-    let means = |t: &[f32]| (0..ROUGHNESS_POINTS).map(|ri| hemispherical_mean(&t[ri * MU_POINTS..][..MU_POINTS])).collect();
+    let means =
+        |t: &[f32]| (0..ROUGHNESS_POINTS).map(|ri| hemispherical_mean(&t[ri * MU_POINTS..][..MU_POINTS])).collect();
     let (a_mean, b_mean) = (means(&a), means(&b));
     Tables { a, b, a_mean, b_mean }
 }
@@ -87,16 +90,20 @@ fn integrate(mu: f32, alpha: f32) -> (f32, f32) {
     ((sa / n) as f32, (sb / n) as f32)
 }
 
-/// `2 ∫₀¹ E(μ) μ dμ` of the piecewise-linear function through `values` at uniform `μ`, exactly.
+/// `2 ∫₀¹ E(μ) μ dμ` of the function linear in `s = sqrt(μ)` between `values` at uniform `s`,
+/// exactly: with `μ = s²`, `2 ∫ E μ dμ = 4 ∫ E(s) s³ ds`.
 fn hemispherical_mean(values: &[f32]) -> f32 {
-    let h = 1.0 / (values.len() - 1) as f32;
+    let h = 1.0 / (values.len() - 1) as f64;
     let mut sum = 0.0;
     for (k, pair) in values.windows(2).enumerate() {
-        let (m0, m1) = (k as f32 * h, (k + 1) as f32 * h);
-        // ∫ over [m0, m1] of the line through (m0, e0), (m1, e1), times μ.
-        sum += h * (pair[0] * (2.0 * m0 + m1) + pair[1] * (m0 + 2.0 * m1)) / 6.0;
+        let (s0, s1) = (k as f64 * h, (k + 1) as f64 * h);
+        let (e0, e1) = (pair[0] as f64, pair[1] as f64);
+        // ∫ s³ ds and ∫ (s - s0) s³ ds over [s0, s1]; E = e0 + (e1 - e0)(s - s0) / h.
+        let m3 = (s1.powi(4) - s0.powi(4)) / 4.0;
+        let m4 = (s1.powi(5) - s0.powi(5)) / 5.0 - s0 * m3;
+        sum += e0 * m3 + (e1 - e0) / h * m4;
     }
-    2.0 * sum
+    (4.0 * sum) as f32
 }
 
 /// The grid cell and the fraction inside it of `x` in `[0, 1]` over `points` nodes.
@@ -117,7 +124,7 @@ pub fn specular_albedo(mu: f32, alpha: f32, f0: f32) -> f32 {
 pub fn albedo_parts(mu: f32, alpha: f32) -> (f32, f32) {
     let t = tables();
     let (ri, fr) = cell(alpha.max(0.0).sqrt(), ROUGHNESS_POINTS);
-    let (mi, fm) = cell(mu.abs(), MU_POINTS);
+    let (mi, fm) = cell(mu.abs().min(1.0).sqrt(), MU_POINTS);
     let bilinear = |v: &[f32]| {
         let row = |r: usize| v[r * MU_POINTS + mi] * (1.0 - fm) + v[r * MU_POINTS + mi + 1] * fm;
         row(ri) * (1.0 - fr) + row(ri + 1) * fr
@@ -172,10 +179,10 @@ mod tests {
     }
 
     #[test]
-    fn the_mean_is_exact_for_a_line() {
-        // E(μ) = μ: 2 ∫ μ² dμ = 2/3; E = 1: 1.
+    fn the_mean_is_exact_for_the_interpolant() {
+        // E = sqrt(μ) (a line in s): 2 ∫ μ^1.5 dμ = 4/5; E = 1: 1.
         let line: Vec<f32> = (0..5).map(|k| k as f32 / 4.0).collect();
-        assert!((hemispherical_mean(&line) - 2.0 / 3.0).abs() < 1e-6);
+        assert!((hemispherical_mean(&line) - 0.8).abs() < 1e-6);
         assert!((hemispherical_mean(&[1.0; 7]) - 1.0).abs() < 1e-6);
     }
 }

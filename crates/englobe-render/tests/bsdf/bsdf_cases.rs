@@ -115,9 +115,17 @@ pub fn smooth_cases() -> Vec<Case> {
     let smooth = TrowbridgeReitz::isotropic(0.0);
     let mut cases = Vec::new();
     for theta in [0.0, 45.0, 85.0] {
-        cases.push(Case::new(format!("smooth gold at {theta}"), Bsdf::conductor(GOLD_ETA, GOLD_K, smooth), dir(theta, 0.0)));
+        cases.push(Case::new(
+            format!("smooth gold at {theta}"),
+            Bsdf::conductor(GOLD_ETA, GOLD_K, smooth),
+            dir(theta, 0.0),
+        ));
         cases.push(Case::new(format!("smooth glass at {theta}"), Bsdf::dielectric(1.5, smooth), dir(theta, 0.0)));
-        cases.push(Case::new(format!("smooth glass inside at {theta}"), Bsdf::dielectric(1.5, smooth), dir(180.0 - theta, 0.0)));
+        cases.push(Case::new(
+            format!("smooth glass inside at {theta}"),
+            Bsdf::dielectric(1.5, smooth),
+            dir(180.0 - theta, 0.0),
+        ));
         let mirror = Bsdf::metallic_roughness(Vec3::new(0.9, 0.6, 0.3), 1.0, 0.0, 0.0, 1.5);
         cases.push(Case::new(format!("gltf mirror at {theta}"), mirror, dir(theta, 0.0)));
         let clear = Bsdf::metallic_roughness(Vec3::ONE, 0.0, 0.0, 1.0, 1.5);

@@ -61,15 +61,15 @@ fn bsdf_ggx_is_normalised() {
         TrowbridgeReitz::new(0.1, 0.7),
     ] {
         // ∫ D(m) cos θm dm = 1: the microsurface projects onto the macrosurface's area.
-        let projected: f64 = cell_probabilities(&|w| (m.d(w) * w.z.max(0.0)) as f64, 1e-9).iter().sum();
+        let projected: f64 = cell_probabilities(&|w| (m.d(w) * w.z.max(0.0)) as f64, 1e-8).iter().sum();
         assert!((projected - 1.0).abs() < 1e-4, "{m:?}: {projected}");
         for wo in [dir(0.0, 0.0), dir(45.0, 20.0), dir(80.0, 110.0), dir(130.0, 60.0)] {
             // ∫ D_wo(m) dm = 1, and the projected-area identity ∫ D(m) max(0, wo·m) dm =
             // |cos θo| (1 + Λ(wo)) (Heitz 2014, equation 18), which ties Λ to D.
-            let visible: f64 = cell_probabilities(&|w| m.d_visible(wo, w) as f64, 1e-9).iter().sum();
+            let visible: f64 = cell_probabilities(&|w| m.d_visible(wo, w) as f64, 1e-8).iter().sum();
             assert!((visible - 1.0).abs() < 1e-4, "{m:?} from {wo}: {visible}");
             let up = if wo.z < 0.0 { -wo } else { wo };
-            let area: f64 = cell_probabilities(&|w| (m.d(w) * up.dot(w).max(0.0)) as f64, 1e-9).iter().sum();
+            let area: f64 = cell_probabilities(&|w| (m.d(w) * up.dot(w).max(0.0)) as f64, 1e-8).iter().sum();
             let expected = (up.z * (1.0 + m.lambda(up))) as f64;
             assert!((area - expected).abs() < 1e-4 * expected, "{m:?} from {wo}: {area} against {expected}");
         }
@@ -109,13 +109,16 @@ fn bsdf_gltf_smooth_metal_is_a_mirror_of_its_base_colour() {
     // Just rough enough not to be a delta: it reflects the same energy, spread about the mirror.
     let rough = Bsdf::metallic_roughness(base, 1.0, 0.05, 0.0, 1.5);
     assert!(!rough.is_delta());
+    // GGX's tails are long: a facet tilts beyond t = tan 2.5° with probability α² / (α² + t²),
+    // 0.33 % at α = 0.0025.
     let mut r = rng(5);
-    let (mut sum, n) = (Vec3::ZERO, 20_000);
+    let (mut sum, mut near, n) = (Vec3::ZERO, 0, 20_000);
     for _ in 0..n {
         if let Some(s) = rough.sample(Vec3::Z, r.random(), Vec2::new(r.random(), r.random())) {
             sum += s.weight;
-            assert!(s.wi.z > 0.99, "close to the mirror direction: {}", s.wi);
+            near += usize::from(s.wi.z > 5f32.to_radians().cos());
         }
     }
-    assert!((sum / n as f32 - base).abs().max_element() < 1e-3, "{}", sum / n as f32);
+    assert!(near as f64 > 0.99 * n as f64, "{near} of {n} within 5 degrees of the mirror direction");
+    assert!((sum / n as f32 - base).abs().max_element() < 2e-3, "{}", sum / n as f32);
 }

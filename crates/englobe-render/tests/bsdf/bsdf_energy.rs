@@ -97,12 +97,8 @@ fn bsdf_albedo_never_exceeds_one() {
 /// lose (the base takes the rest): close to 1 at every roughness and angle, never above.
 #[test]
 fn bsdf_white_gltf_dielectric_is_a_near_white_furnace() {
-    let failures = sweep(
-        "white gltf dielectric",
-        &|r| Bsdf::metallic_roughness(Vec3::ONE, 0.0, r, 0.0, 1.5),
-        &|_, _| 1.0,
-        3e-3,
-    );
+    let failures =
+        sweep("white gltf dielectric", &|r| Bsdf::metallic_roughness(Vec3::ONE, 0.0, r, 0.0, 1.5), &|_, _| 1.0, 3e-3);
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 
@@ -124,7 +120,7 @@ fn bsdf_smooth_glass_is_a_white_furnace() {
 /// cosine-weighted quadrature over the hemisphere, with this crate's microfacet terms.
 #[test]
 fn bsdf_the_literal_gltf_fresnel_mix_is_not_energy_conserving() {
-    let m = TrowbridgeReitz::isotropic(0.25);
+    let m = TrowbridgeReitz::isotropic(0.09);
     let wo = dir(85.0, 0.0);
     let n = 256;
     let mut sum = 0.0f64;
@@ -142,6 +138,6 @@ fn bsdf_the_literal_gltf_fresnel_mix_is_not_energy_conserving() {
     }
     let literal = sum / (n * n) as f64;
     assert!(literal > 1.2, "{literal}");
-    let (ours, se) = albedo(&Bsdf::metallic_roughness(Vec3::ONE, 0.0, 0.5, 0.0, 1.5), wo, 9);
+    let (ours, se) = albedo(&Bsdf::metallic_roughness(Vec3::ONE, 0.0, 0.3, 0.0, 1.5), wo, 9);
     assert!(ours.max_element() <= 1.0 + 5.0 * se.max_element() + 3e-3, "{ours}");
 }

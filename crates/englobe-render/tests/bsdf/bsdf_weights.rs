@@ -106,7 +106,10 @@ fn bsdf_delta_only_models_have_no_density() {
         let s = case.bsdf.sample(case.wo, 0.3, Vec2::new(0.2, 0.7)).unwrap();
         assert!(s.delta, "{}", case.name);
     }
-    assert!(!Bsdf::metallic_roughness(Vec3::ONE, 0.0, 0.0, 0.0, 1.5).is_delta(), "smooth plastic keeps its diffuse base");
+    assert!(
+        !Bsdf::metallic_roughness(Vec3::ONE, 0.0, 0.0, 0.0, 1.5).is_delta(),
+        "smooth plastic keeps its diffuse base"
+    );
     assert!(Bsdf::metallic_roughness(Vec3::ONE, 1.0, 0.0, 0.0, 1.5).is_delta());
 }
 
@@ -114,7 +117,8 @@ fn bsdf_delta_only_models_have_no_density() {
 fn bsdf_grazing_and_degenerate_directions_give_no_nan() {
     let mut cases = rough_cases();
     cases.extend(smooth_cases());
-    let odd = [Vec3::X, Vec3::new(1.0, 0.0, 1e-7).normalize(), Vec3::Z, -Vec3::Z, Vec3::new(0.0, -1.0, -1e-6).normalize()];
+    let odd =
+        [Vec3::X, Vec3::new(1.0, 0.0, 1e-7).normalize(), Vec3::Z, -Vec3::Z, Vec3::new(0.0, -1.0, -1e-6).normalize()];
     for case in &cases {
         for wo in odd {
             for wi in odd {
