@@ -58,6 +58,17 @@ impl Bsdf {
         Bsdf::MetallicRoughness(MetallicRoughness::new(base_color, metallic, roughness, transmission, ior))
     }
 
+    /// Plastic: a Lambertian base of `reflectance` under a dielectric specular layer of index
+    /// `ior` and microfacet `alpha` (clamped to `[0, 1]`), the opaque part of
+    /// [`Bsdf::metallic_roughness`]: Schlick's Fresnel, the base coupled by albedo scaling. It
+    /// stands in for pbrt-v4's `coateddiffuse` (and pbrt-v3's `plastic`), which simulates the
+    /// light bouncing between the two layers stochastically: here the base keeps its own colour,
+    /// where pbrt's darkens and saturates a little through the bounces, and the specular layer
+    /// uses Schlick's Fresnel where pbrt uses the exact equations.
+    pub fn plastic(reflectance: Vec3, alpha: f32, ior: f32) -> Bsdf {
+        Bsdf::MetallicRoughness(MetallicRoughness::with_alpha(reflectance, 0.0, alpha, 0.0, ior))
+    }
+
     /// `f(wo, wi)`, not multiplied by any cosine, over the non-delta lobes (a delta lobe is zero
     /// here). `wo` toward the viewer, `wi` toward the light, both local and unit.
     pub fn eval(&self, wo: Vec3, wi: Vec3) -> Vec3 {

@@ -83,6 +83,11 @@ pub struct MetallicRoughness {
     glass: Dielectric,
 }
 
+/// `x` clamped to `[0, 1]`, and 0 when not finite.
+fn unit(x: f32) -> f32 {
+    if x.is_finite() { x.clamp(0.0, 1.0) } else { 0.0 }
+}
+
 /// The probabilities of the three lobes at one `wo`.
 #[derive(Clone, Copy, Debug)]
 struct LobeChoice {
@@ -95,11 +100,16 @@ impl MetallicRoughness {
     /// The material of a glTF base colour, metalness, perceptual roughness, transmission and
     /// index; each clamped to its range (`ior` at least 1, 1.5 when not finite).
     pub fn new(base_color: Vec3, metallic: f32, roughness: f32, transmission: f32, ior: f32) -> MetallicRoughness {
-        let unit = |x: f32| if x.is_finite() { x.clamp(0.0, 1.0) } else { 0.0 };
+        MetallicRoughness::with_alpha(base_color, metallic, roughness_to_alpha(unit(roughness)), transmission, ior)
+    }
+
+    /// The same material from the microfacet `alpha` itself (clamped to `[0, 1]`, the range of
+    /// the albedo table) instead of glTF's perceptual roughness.
+    pub fn with_alpha(base_color: Vec3, metallic: f32, alpha: f32, transmission: f32, ior: f32) -> MetallicRoughness {
         let base_color = Vec3::new(unit(base_color.x), unit(base_color.y), unit(base_color.z));
         let (metallic, transmission) = (unit(metallic), unit(transmission));
         let ior = if ior.is_finite() { ior.max(1.0) } else { 1.5 };
-        let distribution = TrowbridgeReitz::isotropic(roughness_to_alpha(unit(roughness)));
+        let distribution = TrowbridgeReitz::isotropic(unit(alpha));
         let f0 = f0_from_ior(ior);
         // A smooth layer's albedo is its Fresnel factor: the table's first row, exactly.
         let table_alpha = if distribution.effectively_smooth() { 0.0 } else { distribution.alpha_x };

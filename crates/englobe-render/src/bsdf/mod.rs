@@ -1,5 +1,5 @@
 //! The scattering models of the renderer (BSDFs): Lambert, smooth and rough conductors, smooth
-//! and rough dielectrics, and glTF 2.0's metallic-roughness material, over the Trowbridge-Reitz
+//! and rough dielectrics, plastic, and glTF 2.0's metallic-roughness material, over the Trowbridge-Reitz
 //! (GGX) microfacet distribution with height-correlated Smith masking and visible-normal
 //! sampling. Each file names the papers it implements.
 //!

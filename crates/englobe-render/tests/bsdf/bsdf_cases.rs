@@ -98,6 +98,8 @@ pub fn metallic_roughness_cases() -> Vec<Case> {
             cases.push(Case::new(format!("{name} inside at 30"), b, dir(150.0, 15.0)));
         }
     }
+    let plastic = Bsdf::plastic(Vec3::new(0.2, 0.6, 0.3), 0.2, 1.5);
+    cases.push(Case::new("plastic alpha 0.2 at 45".into(), plastic, dir(45.0, 100.0)));
     cases
 }
 

@@ -90,6 +90,8 @@ fn bsdf_albedo_never_exceeds_one() {
         let make = move |r: f32| Bsdf::metallic_roughness(Vec3::ONE, metallic, r, transmission, 1.5);
         failures.extend(sweep(&name, &make, &none, 3e-3));
     }
+    let plastic = |r: f32| Bsdf::plastic(Vec3::ONE, r, 1.5);
+    failures.extend(sweep("white plastic", &plastic, &|_, _| 1.0, 3e-3));
     assert!(failures.is_empty(), "{} cases:\n{}", failures.len(), failures.join("\n"));
 }
 
