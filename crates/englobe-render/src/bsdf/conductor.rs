@@ -46,7 +46,7 @@ impl ConductorFresnel {
 /// A smooth or rough conductor.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Conductor {
-    /// The microfacet distribution; smooth below [`super::microfacet::SMOOTH_ALPHA`].
+    /// The microfacet distribution; smooth below [`crate::bsdf::SMOOTH_ALPHA`].
     pub distribution: TrowbridgeReitz,
     /// The reflectance of a microfacet.
     pub fresnel: ConductorFresnel,

@@ -31,7 +31,7 @@ pub struct Dielectric {
     /// 1.5 for glass in air. An index of exactly 1 is a pass-through boundary, smooth whatever
     /// the roughness (pbrt-v4 does the same: refraction without bending has no microfacets).
     pub eta: f32,
-    /// The microfacet distribution; smooth below [`super::microfacet::SMOOTH_ALPHA`].
+    /// The microfacet distribution; smooth below [`crate::bsdf::SMOOTH_ALPHA`].
     pub distribution: TrowbridgeReitz,
     /// The colour that transmitted light is multiplied by (white for clear glass).
     pub tint: Vec3,

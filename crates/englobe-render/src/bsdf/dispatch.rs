@@ -31,7 +31,7 @@ impl Bsdf {
 
     /// A conductor of complex index `eta + i k` per channel (relative to the outside medium)
     /// over `distribution` (smooth when its alphas are below
-    /// [`super::microfacet::SMOOTH_ALPHA`]).
+    /// [`crate::bsdf::SMOOTH_ALPHA`]).
     pub fn conductor(eta: Vec3, k: Vec3, distribution: TrowbridgeReitz) -> Bsdf {
         Bsdf::Conductor(Conductor { distribution, fresnel: ConductorFresnel::Complex { eta, k } })
     }
@@ -53,7 +53,7 @@ impl Bsdf {
     /// glTF 2.0's metallic-roughness material: linear `base_color`, `metallic`, perceptual
     /// `roughness` (`alpha = roughness²`), `KHR_materials_transmission`'s `transmission` and
     /// `KHR_materials_ior`'s `ior` (1.5 by default in glTF). See
-    /// [`super::metallic_roughness`].
+    /// [`MetallicRoughness`].
     pub fn metallic_roughness(base_color: Vec3, metallic: f32, roughness: f32, transmission: f32, ior: f32) -> Bsdf {
         Bsdf::MetallicRoughness(MetallicRoughness::new(base_color, metallic, roughness, transmission, ior))
     }
@@ -121,7 +121,7 @@ impl Bsdf {
         match self {
             Bsdf::Lambert(_) | Bsdf::Conductor(_) => false,
             Bsdf::Dielectric(_) => true,
-            Bsdf::MetallicRoughness(b) => b.transmission > 0.0 && b.metallic < 1.0,
+            Bsdf::MetallicRoughness(b) => b.transmission() > 0.0 && b.metallic() < 1.0,
         }
     }
 }

@@ -16,9 +16,10 @@
 //! `fresnel_mix`, which weights the Lambertian base by `1 - F(wo·h)` at the half vector of the
 //! pair: seen at grazing angles that base keeps nearly all of its reflectance while the specular
 //! layer reflects most of the light, and a white material of roughness 0.3 seen at 85 degrees
-//! reflects more than 1.2 times the light it receives (`tests/bsdf/bsdf_energy.rs` measures it). Here the base is coupled by albedo scaling (Kelemen and Szirmay-Kalos 2001; Kulla and
+//! reflects more than 1.2 times the light it receives (`tests/bsdf/bsdf_energy.rs` measures
+//! it). Here the base is coupled by albedo scaling (Kelemen and Szirmay-Kalos 2001; Kulla and
 //! Conty 2017, "Revisiting Physically Based Shading at Imageworks"), which is reciprocal and
-//! conserves energy exactly:
+//! conserves energy (up to the interpolation of the albedo table):
 //!
 //! ```text
 //! diffuse(wo, wi) = base_colour / π · (1 - E(wo)) (1 - E(wi)) / (1 - Ē)
@@ -57,19 +58,16 @@ use super::microfacet::{TrowbridgeReitz, roughness_to_alpha};
 use super::sample::{BsdfSample, SampleKind};
 use super::specular_albedo::{albedo_parts, mean_specular_albedo};
 
-/// glTF 2.0's metallic-roughness material, with transmission and index of refraction.
+/// glTF 2.0's metallic-roughness material, with transmission and index of refraction. Its
+/// parameters are read through methods: the weights and tables derived from them are fixed when
+/// it is made.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct MetallicRoughness {
-    /// Base colour (linear), each channel in `[0, 1]`.
-    pub base_color: Vec3,
-    /// Metalness in `[0, 1]`.
-    pub metallic: f32,
-    /// `KHR_materials_transmission`'s fraction in `[0, 1]` of the dielectric that transmits.
-    pub transmission: f32,
-    /// The index of refraction (`KHR_materials_ior`, 1.5 without it), at least 1.
-    pub ior: f32,
-    /// The distribution of `α = roughness²`.
-    pub distribution: TrowbridgeReitz,
+    base_color: Vec3,
+    metallic: f32,
+    transmission: f32,
+    ior: f32,
+    distribution: TrowbridgeReitz,
     /// Weights of the three parts: metal, opaque dielectric, glass (summing to 1).
     w_metal: f32,
     w_opaque: f32,
@@ -128,6 +126,31 @@ impl MetallicRoughness {
             one_minus_mean,
             glass: Dielectric { eta: ior, distribution, tint: base_color },
         }
+    }
+
+    /// Base colour (linear), each channel in `[0, 1]`.
+    pub fn base_color(&self) -> Vec3 {
+        self.base_color
+    }
+
+    /// Metalness in `[0, 1]`.
+    pub fn metallic(&self) -> f32 {
+        self.metallic
+    }
+
+    /// `KHR_materials_transmission`'s fraction in `[0, 1]` of the dielectric that transmits.
+    pub fn transmission(&self) -> f32 {
+        self.transmission
+    }
+
+    /// The index of refraction (`KHR_materials_ior`, 1.5 without it), at least 1.
+    pub fn ior(&self) -> f32 {
+        self.ior
+    }
+
+    /// The microfacet distribution (isotropic, `alpha = roughness²`).
+    pub fn distribution(&self) -> TrowbridgeReitz {
+        self.distribution
     }
 
     /// True if the surface is smooth: its specular reflection and glass are Dirac deltas, and

@@ -13,7 +13,7 @@ use crate::bsdf_stats::rng;
 fn index_on_side(bsdf: &Bsdf, w: Vec3) -> f32 {
     match bsdf {
         Bsdf::Dielectric(d) if w.z < 0.0 => d.eta,
-        Bsdf::MetallicRoughness(m) if w.z < 0.0 && bsdf.has_transmission() => m.ior,
+        Bsdf::MetallicRoughness(m) if w.z < 0.0 && bsdf.has_transmission() => m.ior(),
         _ => 1.0,
     }
 }

@@ -18,7 +18,7 @@ fn close(a: f32, b: f32, rel: f32) -> bool {
 fn ior_of(bsdf: &Bsdf) -> Option<f32> {
     match bsdf {
         Bsdf::Dielectric(d) => Some(d.eta),
-        Bsdf::MetallicRoughness(m) => Some(m.ior),
+        Bsdf::MetallicRoughness(m) => Some(m.ior()),
         _ => None,
     }
 }
