@@ -4,10 +4,10 @@
 //! metals, Appendix B, "Metals").
 //!
 //! `f(wo, wi) = D(m) G2(wo, wi) F(wo·m) / (4 |cos θo| |cos θi|)` with `m` the half vector
-//! (Torrance and Sparrow 1967; Walter et al. 2007, equation 20), sampled through the visible
-//! normals so that `pdf = D_wo(m) / (4 |wo·m|)` and the weight is `F G2 / G1(wo)` (Heitz 2018,
-//! section 2). As pbrt-v4's `ConductorBxDF` (Pharr, Jakob and Humphreys, "Physically Based
-//! Rendering", 4th edition, section 9.6). Two-sided: below the surface it reflects as above.
+//! (Torrance and Sparrow 1967; Walter et al. 2007), sampled through the visible
+//! normals so that `pdf = D_wo(m) / (4 |wo·m|)` and the weight is `F G2 / G1(wo)` (Heitz 2018).
+//! As pbrt-v4's `ConductorBxDF` (Pharr, Jakob and Humphreys, "Physically Based Rendering", 4th
+//! edition, chapter 9). Two-sided: below the surface it reflects as above.
 
 use englobe::{Vec2, Vec3};
 

@@ -4,17 +4,16 @@
 //! `wo` below the surface (`wo.z < 0`) is inside the denser medium.
 //!
 //! The rough form is Walter, Marschner, Li and Torrance (2007), "Microfacet Models for Refraction
-//! through Rough Surfaces" (EGSR), equations 20 and 21 with the generalised half vector of their
-//! equation 16, in the form of pbrt-v4's `DielectricBxDF` (Pharr, Jakob and Humphreys, "Physically
-//! Based Rendering", 4th edition, section 9.7): the microfacet normal is drawn among those visible
+//! through Rough Surfaces" (EGSR): their BRDF and BTDF over the generalised half vector, in the
+//! form of pbrt-v4's `DielectricBxDF` (Pharr, Jakob and Humphreys, "Physically Based Rendering",
+//! 4th edition, chapter 9): the microfacet normal is drawn among those visible
 //! from `wo`, then reflection or refraction with the Fresnel probability at that normal; the
-//! density is that choice times the Jacobian of the half-vector mapping (Walter et al. equations
-//! 14 and 17).
+//! density is that choice times the Jacobian of the half-vector mapping (Walter et al.).
 //!
 //! Radiance, not importance, is transported: a transmitted `f` is divided by `η'²`, where
 //! `η' = n_i / n_o` is the index on `wi`'s side over the index on `wo`'s side, because radiance
 //! is `n²` times larger in the denser medium (Veach 1997, "Robust Monte Carlo Methods for Light
-//! Transport Simulation", section 5.2; pbrt's `TransportMode::Radiance`). The transmitted light
+//! Transport Simulation", chapter 5; pbrt's `TransportMode::Radiance`). The transmitted light
 //! may be tinted (glTF's `KHR_materials_transmission` tints it with the base colour).
 
 use englobe::{Vec2, Vec3};
@@ -141,7 +140,7 @@ impl Dielectric {
         Some(BsdfSample { wi, weight, pdf: pt, delta: true, kind: SampleKind::Transmission, eta: etap })
     }
 
-    /// The generalised half vector of `wo` and `wi` (Walter et al. 2007, equation 16), facing up,
+    /// The generalised half vector of `wo` and `wi` (Walter et al. 2007), facing up,
     /// or `None` for a degenerate pair or a microfacet that faces away from either direction.
     fn generalized_half(&self, wo: Vec3, wi: Vec3) -> Option<Half> {
         let (cos_o, cos_i) = (wo.z, wi.z);

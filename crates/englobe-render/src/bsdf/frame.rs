@@ -3,10 +3,10 @@
 //!
 //! From a normal alone the basis is Duff, Burgess, Christensen, Hery, Kensler, Liani and Villemin
 //! (2017), "Building an Orthonormal Basis, Revisited" (JCGT 6(1)): one branch on the sign of `z`,
-//! and none of the precision loss that Frisvad's earlier construction suffers near `z = -1`. From a normal and a tangent (a mesh's or a
-//! glTF `TANGENT` attribute with its handedness `w`) the tangent is made orthogonal to the normal
-//! by one Gram-Schmidt step and the bitangent is `w (n × t)`, as the glTF 2.0 specification
-//! defines it (section 3.7.2.1).
+//! and none of the precision loss that Frisvad's earlier construction suffers near `z = -1`.
+//! From a normal and a tangent (a mesh's, or a glTF `TANGENT` attribute with its handedness `w`)
+//! the tangent is made orthogonal to the normal by one Gram-Schmidt step and the bitangent is
+//! `w (n × t)`, as the glTF 2.0 specification defines it for its `TANGENT` attribute.
 
 use englobe::Vec3;
 

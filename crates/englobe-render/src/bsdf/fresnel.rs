@@ -3,7 +3,7 @@
 //! Schlick's approximation from the reflectance at normal incidence.
 //!
 //! The exact forms follow Pharr, Jakob and Humphreys, "Physically Based Rendering", 4th edition,
-//! section 9.5 (`FrDielectric`, `FrComplex`); Schlick (1994), "An Inexpensive BRDF Model for
+//! chapter 9 (`FrDielectric`, `FrComplex`); Schlick (1994), "An Inexpensive BRDF Model for
 //! Physically-based Rendering" gives `F0 + (1 - F0)(1 - cos θ)^5`, which glTF 2.0 (Appendix B,
 //! "Fresnel") uses for both its metals (`F0` = base colour) and its dielectrics
 //! (`F0 = ((ior - 1) / (ior + 1))²`).

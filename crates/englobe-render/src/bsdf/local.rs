@@ -1,6 +1,6 @@
 //! Unit directions in the local shading frame (`z` the normal): their side of the surface, and
 //! the mirror and Snell directions. The formulas are those of Pharr, Jakob and Humphreys,
-//! "Physically Based Rendering", 4th edition, sections 3.8.3 and 9.3-9.5.
+//! "Physically Based Rendering", 4th edition, chapters 3 and 9.
 
 use englobe::Vec3;
 

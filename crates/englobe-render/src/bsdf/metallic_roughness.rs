@@ -43,7 +43,8 @@
 //! share a distribution; the diffuse base; the glass) in proportion to the light each reflects
 //! from `wo` (their albedos from the table and the Fresnel equations at `wo`), and weights the
 //! direction by the whole material's `f |cos θi| / pdf`, `pdf` the mixture of the three lobes'
-//! densities (a one-sample mixture: Veach 1997, section 9.2.4; pbrt-v3's `BSDF::Sample_f`).
+//! densities (Veach 1997's one-sample model with the balance heuristic, thesis chapter 9;
+//! pbrt-v3's `BSDF::Sample_f` does the same).
 
 use std::f32::consts::FRAC_1_PI;
 

@@ -5,17 +5,17 @@
 //!   representation of a rough surface for ray reflection", named GGX by Walter, Marschner, Li
 //!   and Torrance (2007), "Microfacet Models for Refraction through Rough Surfaces" (EGSR), with
 //!   the anisotropic form of Heitz (2014), "Understanding the Masking-Shadowing Function in
-//!   Microfacet-Based BRDFs" (JCGT 3(2)), equation 85.
+//!   Microfacet-Based BRDFs" (JCGT 3(2)), section 5.
 //! - Masking is Smith's, `G1 = 1 / (1 + Λ)`, and masking-shadowing the height-correlated
-//!   `G2 = 1 / (1 + Λ(wo) + Λ(wi))` of Heitz (2014), equation 99.
+//!   `G2 = 1 / (1 + Λ(wo) + Λ(wi))` of Heitz (2014), section 6.
 //! - The distribution of visible normals, `D_wo(m) = G1(wo) max(0, wo·m) D(m) / cos θo` (Heitz
-//!   2014, equation 16), is sampled exactly with the spherical caps of Dupuy and Benyoub (2023),
+//!   2014, section 3), is sampled exactly with the spherical caps of Dupuy and Benyoub (2023),
 //!   "Sound and Complete Visible-Normal Sampling of the GGX Distribution" (arXiv:2306.05044), a
 //!   simpler equivalent of Heitz (2018), "Sampling the GGX Distribution of Visible Normals"
 //!   (JCGT 7(4)): stretch `wo` to the configuration of roughness 1, sample the visible
 //!   hemisphere there as a uniform point on a spherical cap, and stretch back.
 //!
-//! Roughness follows glTF 2.0 (section 3.9.2): `alpha = roughness²`
+//! Roughness follows glTF 2.0 (its metallic-roughness material): `alpha = roughness²`
 //! ([`roughness_to_alpha`]). Below [`SMOOTH_ALPHA`] the distribution is treated as a perfectly
 //! smooth surface (a Dirac delta) as pbrt-v4 does (`EffectivelySmooth`), since its lobes are then
 //! narrower than any light could be sampled; pbrt-v4 tests the smaller of the two alphas, this
@@ -90,7 +90,7 @@ impl TrowbridgeReitz {
     }
 
     /// Smith's auxiliary function `Λ(w) = (sqrt(1 + α(φ)² tan²θ) - 1) / 2` (Heitz 2014,
-    /// equation 86), with `α(φ)² tan²θ = (αx² x² + αy² y²) / z²`; the same for `w` and `-w`,
+    /// section 5), with `α(φ)² tan²θ = (αx² x² + αy² y²) / z²`; the same for `w` and `-w`,
     /// infinite on the horizon.
     pub fn lambda(&self, w: Vec3) -> f32 {
         if w.z == 0.0 {
@@ -114,7 +114,7 @@ impl TrowbridgeReitz {
     }
 
     /// The density of the normals visible from `w`, `D_w(m) = G1(w) max(0, w·m) D(m) / |cos θ|`,
-    /// per unit solid angle of `m` (Heitz 2014, equation 16). For `w` below the surface the
+    /// per unit solid angle of `m` (Heitz 2014, section 3). For `w` below the surface the
     /// normals visible from its mirror image `-w` count (so `w·m` is taken in absolute value).
     pub fn d_visible(&self, w: Vec3, wm: Vec3) -> f32 {
         let cos = abs_cos_theta(w);

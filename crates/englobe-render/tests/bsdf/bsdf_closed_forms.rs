@@ -65,7 +65,7 @@ fn bsdf_ggx_is_normalised() {
         assert!((projected - 1.0).abs() < 1e-4, "{m:?}: {projected}");
         for wo in [dir(0.0, 0.0), dir(45.0, 20.0), dir(80.0, 110.0), dir(130.0, 60.0)] {
             // ∫ D_wo(m) dm = 1, and the projected-area identity ∫ D(m) max(0, wo·m) dm =
-            // |cos θo| (1 + Λ(wo)) (Heitz 2014, equation 18), which ties Λ to D.
+            // |cos θo| (1 + Λ(wo)) (Heitz 2014, section 3), which ties Λ to D.
             let visible: f64 = cell_probabilities(&|w| m.d_visible(wo, w) as f64, 1e-8).iter().sum();
             assert!((visible - 1.0).abs() < 1e-4, "{m:?} from {wo}: {visible}");
             let up = if wo.z < 0.0 { -wo } else { wo };

@@ -1,6 +1,6 @@
 //! Helmholtz reciprocity: `f(wo, wi) = f(wi, wo)` for every reflection, and for transmission the
 //! generalised reciprocity of radiance BSDFs, `f(wo, wi) n(wi)² = f(wi, wo) n(wo)²` (Veach 1997,
-//! section 5.2), `n` the index on each direction's side.
+//! chapter 5), `n` the index on each direction's side.
 
 use englobe::Vec3;
 use englobe_render::bsdf::Bsdf;
