@@ -15,6 +15,7 @@
 //! # Ok(()) }
 //! ```
 
+pub mod bsdf;
 pub mod camera;
 pub mod cost;
 pub mod digest;
