@@ -130,3 +130,78 @@ fn a_refused_move_changes_nothing() {
     let untouched = World::build(start, AccelKind::BvhWide).unwrap();
     same_answers(&world, &untouched, &rays(&mut rng), "after refused moves");
 }
+
+/// `mesh` with every vertex moved a little (the same triangles).
+fn jittered(mesh: &TriangleMesh, rng: &mut Pcg32, amount: f32) -> TriangleMesh {
+    let positions = mesh
+        .positions()
+        .iter()
+        .map(|p| {
+            *p + Vec3::new(
+                rng.random_range(-amount..amount),
+                rng.random_range(-amount..amount),
+                rng.random_range(-amount..amount),
+            )
+        })
+        .collect();
+    TriangleMesh::new(positions, mesh.triangles().to_vec()).unwrap()
+}
+
+#[test]
+fn refitted_worlds_answer_as_worlds_built_from_scratch() {
+    let meshes = [grid(4, 1), grid(3, 2)];
+    for &kind in AccelKind::ALL {
+        let mut rng = Pcg32::seed_from_u64(13);
+        let start = objects(&mut rng, &meshes, true);
+        let mut world = World::build(start.clone(), kind).unwrap();
+        let mut moved = start;
+        for frame in 0..3 {
+            // The plain mesh (object 0) deforms, and so does the first instanced mesh.
+            let Object::Mesh(plain) = &moved[0] else { unreachable!() };
+            let plain = jittered(plain, &mut rng, 0.4);
+            moved[0] = Object::Mesh(Arc::new(plain.clone()));
+            let report = world.refit_mesh(0, plain).unwrap();
+            // The fast path refits its tree; the teaching structures are built again.
+            match kind {
+                AccelKind::BvhWide => assert!(!report.rebuilt && report.sah_cost > 0.0, "{kind}: {report:?}"),
+                _ => assert!(report.rebuilt, "{kind}: {report:?}"),
+            }
+
+            let Object::Instance(first) = &moved[1] else { unreachable!() };
+            let placed = first.mesh().clone();
+            let new_mesh = Arc::new(jittered(&placed, &mut rng, 0.3));
+            for o in &mut moved {
+                if let Object::Instance(inst) = o
+                    && Arc::ptr_eq(inst.mesh(), &placed)
+                {
+                    *o = Instance::new(new_mesh.clone(), *inst.to_world()).unwrap().into();
+                }
+            }
+            world.refit_instanced_mesh(&placed, new_mesh).unwrap();
+            let fresh = World::build(moved.clone(), kind).unwrap();
+            same_answers(&world, &fresh, &rays(&mut rng), &format!("{kind}, refit frame {frame}"));
+        }
+    }
+}
+
+#[test]
+fn refits_of_other_triangles_or_objects_are_refused() {
+    let meshes = [grid(3, 3)];
+    let mut rng = Pcg32::seed_from_u64(17);
+    let start = objects(&mut rng, &meshes, true);
+    let mut world = World::build(start.clone(), AccelKind::BvhWide).unwrap();
+    let Object::Mesh(plain) = &start[0] else { unreachable!() };
+    let mut flipped = plain.triangles().to_vec();
+    flipped[0].swap(1, 2);
+    let other = TriangleMesh::new(plain.positions().to_vec(), flipped).unwrap();
+    assert!(matches!(world.refit_mesh(0, other.clone()), Err(WorldError::OtherTriangles { object: 0 })));
+    assert!(matches!(world.refit_mesh(1, other.clone()), Err(WorldError::NotAMesh { object: 1 })));
+    assert!(matches!(world.refit_instanced_mesh(plain, Arc::new(other)), Err(WorldError::NotInstanced)));
+    let fewer = TriangleMesh::new(meshes[0].positions().to_vec(), meshes[0].triangles()[1..].to_vec()).unwrap();
+    assert!(matches!(
+        world.refit_instanced_mesh(&meshes[0], Arc::new(fewer)),
+        Err(WorldError::OtherInstancedTriangles)
+    ));
+    let untouched = World::build(start, AccelKind::BvhWide).unwrap();
+    same_answers(&world, &untouched, &rays(&mut rng), "after refused refits");
+}

@@ -70,6 +70,19 @@ impl BottomLevel {
         }
     }
 
+    /// The fast structure, to refit.
+    pub(super) fn triangle_bvh_mut(&mut self) -> Option<&mut TriangleBvh> {
+        match &mut self.accel {
+            BottomAccel::Triangles(t) => Some(t),
+            BottomAccel::Generic(_) => None,
+        }
+    }
+
+    /// Puts `mesh` in place of the mesh, once the structure fits it.
+    pub(super) fn set_mesh(&mut self, mesh: Arc<TriangleMesh>) {
+        self.mesh = mesh;
+    }
+
     /// The closest triangle hit by `ray`, given in the mesh's space: `prim` is the triangle.
     #[inline]
     pub fn closest_hit<C: Counters>(&self, ray: &Ray, counters: &mut C) -> Option<Hit> {

@@ -24,6 +24,9 @@
 //!
 //! Every kind gives the same answers, bit for bit: a triangle's test is the same watertight test
 //! everywhere, and ties at equal `t` go to the lower number at every level.
+//!
+//! Worlds move without being built again: instances are placed anew (`motion.rs`) and meshes
+//! deform (`refit.rs`), the structures refitted or rebuilt only above what changed.
 
 use glam::Vec3;
 
@@ -33,6 +36,7 @@ mod motion;
 mod object;
 mod proximity;
 mod query;
+mod refit;
 
 use crate::PrimHit;
 use crate::accel::{Accel, AccelKind, AnyAccel, MAX_PRIMITIVES, StructureStats, TriangleBvh};
@@ -62,6 +66,24 @@ pub enum WorldError {
         /// Object index.
         object: usize,
     },
+    /// [`World::refit_mesh`] was asked to refit an object that is not a plain mesh.
+    #[error("object {object} is not a mesh: only meshes are refitted")]
+    NotAMesh {
+        /// Object index.
+        object: usize,
+    },
+    /// [`World::refit_mesh`] was given a mesh whose triangles are not the object's.
+    #[error("object {object}: the new mesh's triangles differ from the old one's (a refit moves vertices only)")]
+    OtherTriangles {
+        /// Object index.
+        object: usize,
+    },
+    /// [`World::refit_instanced_mesh`] was given a mesh no instance of the world places.
+    #[error("no instance of the world places this mesh")]
+    NotInstanced,
+    /// [`World::refit_instanced_mesh`] was given a mesh whose triangles are not the placed one's.
+    #[error("the new mesh's triangles differ from the instanced one's (a refit moves vertices only)")]
+    OtherInstancedTriangles,
     /// [`World::move_instances`] was given a transform the instance refuses.
     #[error("object {object}: {source}")]
     Instance {

@@ -49,6 +49,12 @@ impl World {
         for (object, moved) in placed {
             self.objects[object] = Object::Instance(moved);
         }
+        self.rebuild_top();
+        Ok(())
+    }
+
+    /// Builds the structure above the bottom levels again, from the objects as they are now.
+    pub(super) fn rebuild_top(&mut self) {
         self.accel = match (&self.accel_prims, self.kind) {
             // The fast path with plain meshes: the structure over shapes and instances only.
             (Some(prims), _) => {
@@ -62,7 +68,6 @@ impl World {
                 accel_over_all(kind, &self.objects, &self.prim_object, &self.object_first_prim, &boxes)
             }
         };
-        Ok(())
     }
 
     /// The box of primitive `prim`, as [`World::build`] computes it.
@@ -76,7 +81,7 @@ impl World {
     }
 
     /// The boxes of every bounded primitive, by primitive number.
-    fn all_bounds(&self) -> Vec<Aabb> {
+    pub(super) fn all_bounds(&self) -> Vec<Aabb> {
         (0..self.prim_object.len() as u32).map(|p| self.prim_bounds(p)).collect()
     }
 }
