@@ -174,7 +174,16 @@ impl Converter<'_> {
             let material = lookup(&r.get_ref().material)?;
             push(self.random_triangles(r)?, material);
         }
-        let mut scene = Scene { image, camera, lights, materials, material_names, objects, warnings: Vec::new() };
+        let mut scene = Scene {
+            image,
+            camera,
+            lights,
+            materials,
+            material_names,
+            textures: Vec::new(),
+            objects,
+            warnings: Vec::new(),
+        };
         self.meshes(def.mesh, &mut scene)?;
         Ok(scene)
     }
@@ -278,6 +287,7 @@ impl Converter<'_> {
                 transparency: d.transparency.map_or(base.transparency, |x| x.0),
                 ior: d.ior.map_or(base.ior, |x| x.0),
                 emission: d.emission.map_or(base.emission, |c| c.0),
+                ..base
             };
             if m.reflectivity + m.transparency > 1.0 {
                 return Err(self.err(

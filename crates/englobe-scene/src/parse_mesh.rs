@@ -89,7 +89,12 @@ impl Converter<'_> {
                 None => (0, cached.triangle_materials.clone()),
             };
             let mut push = |object: Object| {
-                scene.objects.push(SceneObject { object, material, triangle_materials: triangle_materials.clone() })
+                scene.objects.push(SceneObject {
+                    object,
+                    material,
+                    triangle_materials: triangle_materials.clone(),
+                    tangents: None,
+                })
             };
 
             let instances = self.instances(&d.instances, &d.grid, entry_span.clone())?;

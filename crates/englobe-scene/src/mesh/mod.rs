@@ -25,8 +25,8 @@ pub use error::{MeshErrorKind, MeshFileError, Position};
 pub use loaded::{LoadedMesh, MAX_MESH_FILE_BYTES, MAX_MTL_FILE_BYTES, MeshFormat, NO_MATERIAL, NamedMaterial};
 pub use transform::bake_transform;
 
-pub(crate) use read::read_at_most;
-use read::{check_file, read_limited};
+use read::check_file;
+pub(crate) use read::{guarded, read_at_most, read_limited};
 
 /// Reads and checks the mesh file `path`, choosing the format by its extension.
 pub fn load_mesh_file(path: &Path) -> Result<LoadedMesh, MeshFileError> {

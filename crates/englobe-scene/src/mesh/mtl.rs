@@ -127,6 +127,7 @@ pub(super) fn to_material(m: &tobj::Material) -> Material {
         transparency,
         ior: m.optical_density.filter(|n| *n > 0.0).unwrap_or(base.ior),
         emission: color(m.emissive, Vec3::ZERO),
+        ..base
     }
 }
 
