@@ -15,6 +15,7 @@ pub mod model;
 pub mod numbers;
 pub mod overrides;
 pub mod parse;
+mod parse_material;
 mod parse_mesh;
 pub mod random_triangles;
 pub mod shared_data;

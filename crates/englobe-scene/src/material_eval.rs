@@ -26,6 +26,18 @@ use crate::texture::{ColorSpace, Texture};
 /// Base colour shown where a base colour texture could not be read.
 pub const MISSING_TEXTURE_COLOR: Vec3 = Vec3::new(1.0, 0.0, 1.0);
 
+/// What a material shows in place of an unreadable texture in `slot` (as loaders name slots in
+/// warnings: "base colour", "normal", ...).
+pub(crate) fn fallback_text(slot: &str) -> &'static str {
+    match slot {
+        "base colour" => "the surface shows magenta there",
+        "emission" => "the surface does not glow",
+        "normal" | "bump" => "the interpolated normal is used",
+        "alpha" => "the surface is opaque",
+        _ => "the material's factors are used alone",
+    }
+}
+
 /// The parameters of a surface at one point, textures applied.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SurfaceParams {

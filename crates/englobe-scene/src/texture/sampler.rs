@@ -9,7 +9,7 @@ use glam::{Vec2, Vec4};
 use super::image::{ColorSpace, TexelImage};
 
 /// What happens to coordinates outside `0..1` along one axis.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum Wrap {
     /// The image tiles the plane (glTF's default, `REPEAT` 10497).
     #[default]
@@ -21,7 +21,7 @@ pub enum Wrap {
 }
 
 /// How texels are combined.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum Filter {
     /// The four nearest texels weighted by distance.
     #[default]
@@ -31,7 +31,7 @@ pub enum Filter {
 }
 
 /// A sampler: a wrap mode per axis and a filter.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub struct Sampler {
     /// Along `u` (across the image).
     pub wrap_u: Wrap,
