@@ -161,6 +161,10 @@ pub struct MaterialTextures {
     pub alpha: Option<ScalarTexture>,
     /// Highlight colour (MTL `map_Ks`), sRGB.
     pub specular: Option<TextureRef>,
+    /// Ambient occlusion (glTF `occlusionTexture`: red channel, its `strength` as the remap
+    /// `1 - strength + strength * red`), linear. A path tracer computes occlusion itself; the
+    /// classic ambient term is what this approximates.
+    pub occlusion: Option<ScalarTexture>,
 }
 
 impl MaterialTextures {
@@ -178,6 +182,7 @@ impl MaterialTextures {
         push("emission", self.emission);
         push("alpha", self.alpha.map(|a| a.texture));
         push("specular", self.specular);
+        push("occlusion", self.occlusion.map(|o| o.texture));
         out
     }
 
@@ -197,6 +202,7 @@ impl MaterialTextures {
         t.emission.as_mut().map(shift);
         t.alpha.as_mut().map(|a| shift(&mut a.texture));
         t.specular.as_mut().map(shift);
+        t.occlusion.as_mut().map(|o| shift(&mut o.texture));
         t
     }
 }

@@ -62,6 +62,9 @@ pub struct SurfaceParams {
     /// Highlight colour: classic `specular` (times `map_Ks`); under metallic-roughness the
     /// dielectric's specular colour factor, 1 (englobe does not read `KHR_materials_specular`).
     pub specular: Vec3,
+    /// Ambient occlusion in `0..=1` from the occlusion texture (1 without one): for ambient
+    /// terms only, never for light that is traced.
+    pub occlusion: f32,
 }
 
 fn lookup(textures: &[Arc<Texture>], r: &TextureRef, uv: Vec2, space: ColorSpace) -> Option<Vec4> {
@@ -134,6 +137,10 @@ impl Material {
             emission,
             normal_ts,
             specular,
+            occlusion: match (&t.occlusion, uv) {
+                (Some(o), Some(uv)) => scalar(textures, o, uv).unwrap_or(1.0).clamp(0.0, 1.0),
+                _ => 1.0,
+            },
         }
     }
 
@@ -235,8 +242,11 @@ mod tests {
         let mut m = Material::metallic_roughness(Vec3::new(0.5, 1.0, 1.0), 1.0, 0.5);
         m.textures.base_color = Some(TextureRef::new(0));
         m.textures.metallic_roughness = Some(TextureRef::new(0));
+        m.textures.occlusion =
+            Some(ScalarTexture { texture: TextureRef::new(0), channel: Channel::Red, remap: Some([0.2, 0.8]) });
         let p = m.evaluate(&textures, Some(Vec2::new(0.3, 0.6)));
         assert!((p.base_color.x - 0.5 * 0.5029).abs() < 1e-3, "{p:?}");
+        assert!((p.occlusion - (0.2 + 0.8 * 188.0 / 255.0)).abs() < 1e-6, "strength 0.8");
         assert!((p.base_color.y - crate::texture::srgb_to_linear(128.0 / 255.0)).abs() < 1e-6);
         assert!((p.metallic - 64.0 / 255.0).abs() < 1e-6 && (p.roughness - 0.5 * 128.0 / 255.0).abs() < 1e-6);
         assert_eq!(p.alpha, 1.0, "opaque ignores alpha");

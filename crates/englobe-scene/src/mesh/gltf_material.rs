@@ -3,8 +3,8 @@
 //! texture and its scale, the emissive factor and texture with `KHR_materials_emissive_strength`,
 //! `alphaMode` and `alphaCutoff`, `doubleSided`, `KHR_materials_transmission` and
 //! `KHR_materials_ior`, and `KHR_texture_transform` on the textures that carry it (the `gltf`
-//! crate keeps it on all but the normal texture). Occlusion textures are not read: a path tracer
-//! computes the occlusion they approximate (the specification leaves its use to the viewer).
+//! crate keeps it on all but the normal and occlusion textures). The occlusion texture is kept
+//! for ambient terms (a path tracer computes the occlusion it approximates).
 //!
 //! Images come from files beside the `.gltf` (URIs relative to it, percent-decoded), `data:`
 //! URIs, or buffer views (the GLB binary chunk). Each glTF texture becomes one
@@ -23,7 +23,10 @@ use gltf::json::validation::Checked;
 
 use super::gltf_data::{Buffers, decode_base64, percent_decode};
 use super::loaded::NamedMaterial;
-use crate::material::{Alpha, AlphaMode, Material, MaterialModel, NormalEncoding, NormalMap, TextureRef, UvTransform};
+use crate::material::{
+    Alpha, AlphaMode, Channel, Material, MaterialModel, NormalEncoding, NormalMap, ScalarTexture, TextureRef,
+    UvTransform,
+};
 use crate::material_eval::fallback_text;
 use crate::texture::{Filter, Sampler, Texture, TextureId, TextureLoader, TextureSource, Wrap};
 
@@ -107,6 +110,11 @@ impl Reader<'_, '_> {
         t.normal = m.normal_texture.as_ref().and_then(|n| {
             let texture = self.reference(name, "normal", n.index.value(), n.tex_coord, None)?;
             Some(NormalMap { texture, scale: finite(n.scale, 1.0), encoding: NormalEncoding::TangentSpace })
+        });
+        t.occlusion = m.occlusion_texture.as_ref().and_then(|o| {
+            let texture = self.reference(name, "occlusion", o.index.value(), o.tex_coord, None)?;
+            let strength = finite(o.strength.0, 1.0).clamp(0.0, 1.0);
+            Some(ScalarTexture { texture, channel: Channel::Red, remap: Some([1.0 - strength, strength]) })
         });
         if transmission.is_some_and(|t| t.transmission_texture.is_some()) {
             self.out
@@ -206,8 +214,10 @@ impl Reader<'_, '_> {
                 (uri.clone(), TextureSource::Embedded(key), Err(format!("the external URI `{uri}` is not fetched")))
             }
             (Some(uri), _) => {
-                let file = self.path.parent().unwrap_or(Path::new("")).join(percent_decode(uri));
-                let name = Path::new(uri).file_name().map_or(uri.clone(), |n| n.to_string_lossy().into_owned());
+                let decoded = percent_decode(uri);
+                let file = self.path.parent().unwrap_or(Path::new("")).join(&decoded);
+                let name =
+                    Path::new(&decoded).file_name().map_or(decoded.clone(), |n| n.to_string_lossy().into_owned());
                 (name, TextureSource::File(file.clone()), self.loader.file(&file))
             }
             (None, Some(view)) => {

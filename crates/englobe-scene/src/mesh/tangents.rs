@@ -81,8 +81,14 @@ pub(super) fn generate_tangents(
     Some(
         (0..n)
             .map(|v| {
-                let normal = normals.map_or(Vec3::Z, |ns| ns[v]);
-                let t = g.sum[v].try_normalize().unwrap_or_else(|| normal.any_orthonormal_vector());
+                // MikkTSpace leaves a default (1, 0, 0) where the texture mapping is degenerate:
+                // made perpendicular to the normal like the others.
+                let t = match normals.and_then(|ns| ns[v].try_normalize()) {
+                    Some(n) => {
+                        (g.sum[v] - n * n.dot(g.sum[v])).try_normalize().unwrap_or_else(|| n.any_orthonormal_vector())
+                    }
+                    None => g.sum[v].try_normalize().unwrap_or(Vec3::X),
+                };
                 t.extend(if g.sign[v] < 0.0 { -1.0 } else { 1.0 })
             })
             .collect(),
