@@ -68,6 +68,13 @@ fn read_mesh_file(path: &Path) -> Result<LoadedMesh, MeshFileError> {
     load_mesh_bytes(path, format, bytes)
 }
 
+/// Checks the text of an MTL material library as OBJ loading does (every statement, texture
+/// statements and their options included), without reading the textures; `path` names it in
+/// errors.
+pub fn check_mtl_text(path: &Path, text: &str) -> Result<(), MeshFileError> {
+    mtl::scan(path, text).map(|_| ())
+}
+
 /// Reads and checks a mesh already in memory, as it is in the file (no normals or tangents
 /// generated). `path` names it in errors, and files it refers to (an OBJ's material libraries,
 /// a glTF's buffers and images) are looked for beside it.
