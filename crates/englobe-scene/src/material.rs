@@ -195,14 +195,18 @@ impl MaterialTextures {
     /// appended after the scene's).
     pub fn shifted(&self, offset: TextureId) -> Self {
         let mut t = self.clone();
-        let shift = |r: &mut TextureRef| r.texture += offset;
-        t.base_color.as_mut().map(shift);
-        t.metallic_roughness.as_mut().map(shift);
-        t.normal.as_mut().map(|n| shift(&mut n.texture));
-        t.emission.as_mut().map(shift);
-        t.alpha.as_mut().map(|a| shift(&mut a.texture));
-        t.specular.as_mut().map(shift);
-        t.occlusion.as_mut().map(|o| shift(&mut o.texture));
+        let refs = [
+            t.base_color.as_mut(),
+            t.metallic_roughness.as_mut(),
+            t.normal.as_mut().map(|n| &mut n.texture),
+            t.emission.as_mut(),
+            t.alpha.as_mut().map(|a| &mut a.texture),
+            t.specular.as_mut(),
+            t.occlusion.as_mut().map(|o| &mut o.texture),
+        ];
+        for r in refs.into_iter().flatten() {
+            r.texture += offset;
+        }
         t
     }
 }

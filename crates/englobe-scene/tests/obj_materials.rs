@@ -103,13 +103,17 @@ fn the_cornell_box_boxes_are_white() {
     }
     let walls = &m.materials.iter().find(|(n, _)| n == "leftWall").unwrap().1;
     assert_eq!(walls.diffuse, Vec3::new(0.63, 0.065, 0.05));
-    // The walls meet at right angles: smoothing at 60 degrees leaves every normal a face normal.
+    // The walls and box faces meet at about right angles: smoothing at 60 degrees joins only the
+    // two slightly bent halves of each quad (the measured box is not square), never two faces,
+    // which would tilt normals by about 45 degrees.
     let normals = m.mesh.normals().unwrap();
+    let mut worst = 0.0f32;
     for i in 0..m.mesh.len() as u32 {
         for &v in &m.mesh.triangles()[i as usize] {
-            assert!((normals[v as usize] - m.mesh.geometric_normal(i)).length() < 1e-3);
+            worst = worst.max(normals[v as usize].angle_between(m.mesh.geometric_normal(i)).to_degrees());
         }
     }
+    assert!(worst < 1.0, "a shading normal {worst} degrees off its face");
 }
 
 #[test]

@@ -11,11 +11,11 @@
 mod decode;
 mod image;
 mod sampler;
+mod scene_texture;
 mod srgb;
-mod texture;
 
 pub use decode::{MAX_TEXTURE_FILE_BYTES, MAX_TEXTURE_PIXELS, TextureError, TextureLoader, decode_image};
 pub use image::{ColorSpace, TexelImage, Texels};
 pub use sampler::{Filter, Sampler, Wrap};
+pub use scene_texture::{Texture, TextureId, TextureSource};
 pub use srgb::{linear_to_srgb, srgb_to_linear};
-pub use texture::{Texture, TextureId, TextureSource};
