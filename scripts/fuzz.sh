@@ -14,7 +14,7 @@ cd "$(dirname "$0")/.."
 seconds=${1:-60}
 shift || true
 targets=("$@")
-[ ${#targets[@]} -gt 0 ] || targets=(scene_toml mesh_obj mesh_ply mesh_gltf tile_exr)
+[ ${#targets[@]} -gt 0 ] || targets=(scene_toml mesh_obj mesh_ply mesh_gltf tile_exr mtl_text texture_image)
 shared=${ENGLOBE_SHARED:-../shared}
 
 seed() {
@@ -25,6 +25,8 @@ seed() {
         mesh_obj) find "$shared/scenes/meshes" -name '*.obj' -size -200k -exec cp {} "$dir/" \; ;;
         mesh_ply) find "$shared/scenes/meshes" -name '*.ply' -size -2M -exec cp {} "$dir/" \; ;;
         mesh_gltf) find "$shared/scenes/meshes" \( -name '*.gltf' -o -name '*.glb' \) -size -2M -exec cp {} "$dir/" \; ;;
+        mtl_text) find "$shared/scenes/meshes" -name '*.mtl' -size -200k -exec cp {} "$dir/" \; ;;
+        texture_image) find "$shared/scenes/meshes" \( -name '*.png' -o -name '*.jpg' \) -size -200k -exec cp {} "$dir/" \; ;;
         tile_exr)
             for t in 0/1 1/3; do
                 cargo run -q -- render --width 16 --height 9 --spp 1 --tile "$t" -o "$dir/tile-${t%/*}.exr" -q

@@ -1,5 +1,6 @@
 //! `englobe info FILE`: what a mesh file or a scene file holds (triangles, vertices, bounds,
-//! materials, instances, warnings), or the error that refuses it.
+//! materials with their model, factors and texture slots, textures with their sizes and which
+//! could not be read, instances, warnings), or the error that refuses it.
 
 use std::collections::HashSet;
 use std::fmt::Write as _;
@@ -8,8 +9,8 @@ use std::process::ExitCode;
 
 use clap::Args;
 use englobe::{Aabb, Bounded, Object, Shape, TriangleMesh};
-use englobe_scene::mesh::{LoadedMesh, load_mesh_file};
-use englobe_scene::{Scene, load_scene};
+use englobe_scene::mesh::{DEFAULT_SMOOTH_ANGLE, LoadedMesh, MeshOptions, load_mesh_file_with};
+use englobe_scene::{Material, MaterialModel, Scene, Texture, load_scene};
 
 #[derive(Args)]
 pub struct InfoArgs {
@@ -22,7 +23,11 @@ pub fn run(args: InfoArgs) -> anyhow::Result<ExitCode> {
     let text = if is_scene {
         scene_info(&args.file, &load_scene(&args.file)?)
     } else {
-        mesh_info(&args.file, &load_mesh_file(&args.file)?)
+        // The file as it is: no normals generated (its vertex count stays the file's).
+        mesh_info(
+            &args.file,
+            &load_mesh_file_with(&args.file, &MeshOptions { smooth_angle: 0.0, want_tangents: false })?,
+        )
     };
     print!("{text}");
     Ok(ExitCode::SUCCESS)
@@ -53,17 +58,92 @@ pub fn mesh_info(path: &Path, m: &LoadedMesh) -> String {
     let _ = writeln!(out, "triangles:  {}", mesh.len());
     let _ = writeln!(out, "vertices:   {}", mesh.positions().len());
     let yes = |b: bool| if b { "yes" } else { "no" };
-    let _ = writeln!(out, "normals:    {}", yes(mesh.normals().is_some()));
+    let normals = if mesh.normals().is_some() {
+        "yes".to_owned()
+    } else {
+        format!(
+            "no (a scene smooths them within {DEFAULT_SMOOTH_ANGLE} degrees unless its `smooth_angle` says otherwise)"
+        )
+    };
+    let _ = writeln!(out, "normals:    {normals}");
     let _ = writeln!(out, "uvs:        {}", yes(mesh.uvs().is_some()));
+    let _ = writeln!(out, "tangents:   {}", yes(m.tangents.is_some()));
     bounds_lines(&mut out, &mesh.bounds());
     let _ = writeln!(out, "memory:     {} bytes (vertices, triangles and attributes)", mesh_bytes(mesh));
     let _ = writeln!(out, "materials:  {}", m.materials.len());
     for (i, (name, mat)) in m.materials.iter().enumerate() {
         let used = m.triangle_materials.as_ref().map_or(0, |ids| ids.iter().filter(|&&id| id == i as u32).count());
-        let _ = writeln!(out, "  - {name}: diffuse {}, emission {}, {used} triangles", mat.diffuse, mat.emission);
+        let _ = writeln!(out, "  - {name}: {}, {used} triangles", material_text(mat, &m.textures));
     }
+    textures_lines(&mut out, &m.textures, m.materials.iter().map(|(n, m)| (n.as_str(), m)));
     warnings_lines(&mut out, &m.warnings);
     out
+}
+
+/// A material's model, factors and texture slots on one line.
+fn material_text(m: &Material, textures: &[std::sync::Arc<Texture>]) -> String {
+    let mut s = match m.model {
+        MaterialModel::Classic => format!(
+            "classic, diffuse {}, specular {}, shininess {}, reflectivity {}, transparency {}, ior {}",
+            m.diffuse, m.specular, m.shininess, m.reflectivity, m.transparency, m.ior
+        ),
+        MaterialModel::MetallicRoughness { metallic, roughness, transmission } => format!(
+            "metallic_roughness, base colour {}, metallic {metallic}, roughness {roughness}, transmission {transmission}, ior {}",
+            m.diffuse, m.ior
+        ),
+    };
+    if m.emission != englobe::Vec3::ZERO {
+        let _ = write!(s, ", emission {}", m.emission);
+    }
+    match m.alpha.mode {
+        englobe_scene::AlphaMode::Opaque => {}
+        englobe_scene::AlphaMode::Mask { cutoff } => {
+            let _ = write!(s, ", alpha mask {} (cutoff {cutoff})", m.alpha.factor);
+        }
+        englobe_scene::AlphaMode::Blend => {
+            let _ = write!(s, ", alpha blend {}", m.alpha.factor);
+        }
+    }
+    if !m.double_sided {
+        s += ", single-sided";
+    }
+    for (slot, r) in m.textures.slots() {
+        let name = textures.get(r.texture as usize).map_or("(missing)", |t| t.name.as_str());
+        let _ = write!(s, ", {slot} texture {name}");
+    }
+    s
+}
+
+/// The textures, each with its size and the material slots that use it, or why it could not be
+/// read.
+fn textures_lines<'a>(
+    out: &mut String,
+    textures: &[std::sync::Arc<Texture>],
+    materials: impl Iterator<Item = (&'a str, &'a Material)>,
+) {
+    let mut uses: Vec<Vec<String>> = vec![Vec::new(); textures.len()];
+    for (name, m) in materials {
+        for (slot, r) in m.textures.slots() {
+            if let Some(u) = uses.get_mut(r.texture as usize) {
+                u.push(format!("{name} {slot}"));
+            }
+        }
+    }
+    let unreadable = textures.iter().filter(|t| t.image.is_none()).count();
+    let _ = writeln!(out, "textures:   {} ({unreadable} unreadable)", textures.len());
+    for (t, used) in textures.iter().zip(&uses) {
+        let what = match (&t.image, &t.error) {
+            (Some(i), _) => format!("{}x{}, {} channels, {} bits", i.width(), i.height(), i.channels(), i.bits()),
+            (None, e) => format!("UNREADABLE: {}", e.as_deref().unwrap_or("unknown")),
+        };
+        let _ = writeln!(
+            out,
+            "  - {} ({}): {what}; used as {}",
+            t.name,
+            t.source,
+            if used.is_empty() { "nothing".into() } else { used.join(", ") }
+        );
+    }
 }
 
 /// Bytes held by a mesh's arrays.
@@ -131,9 +211,10 @@ pub fn scene_info(path: &Path, scene: &Scene) -> String {
     let _ = writeln!(out, "meshes:     {} distinct, {stored_bytes} bytes of mesh data", distinct.len());
     bounds_lines(&mut out, &bounds);
     let _ = writeln!(out, "materials:  {}", scene.materials.len());
-    for name in &scene.material_names {
-        let _ = writeln!(out, "  - {name}");
+    for (name, mat) in scene.material_names.iter().zip(&scene.materials) {
+        let _ = writeln!(out, "  - {name}: {}", material_text(mat, &scene.textures));
     }
+    textures_lines(&mut out, &scene.textures, scene.material_names.iter().map(String::as_str).zip(&scene.materials));
     warnings_lines(&mut out, &scene.warnings);
     out
 }

@@ -31,9 +31,38 @@ fn info_describes_mesh_files() {
     let shown = text(&englobe(&["info", cornell.to_str().unwrap()]).stdout);
     assert!(
         shown.contains("materials:  8")
-            && shown.contains("light: diffuse [0.78, 0.78, 0.78], emission [17, 12, 4], 2 triangles"),
+            && shown.contains("light: classic, diffuse [0.78, 0.78, 0.78],")
+            && shown.contains("emission [17, 12, 4], 2 triangles")
+            && shown.contains("textures:   0 (0 unreadable)"),
         "{shown}"
     );
+}
+
+#[test]
+fn info_lists_materials_and_textures_and_what_could_not_be_read() {
+    let helmet = shared_meshes_or_panic(&repo()).join("gltf/DamagedHelmet/DamagedHelmet.gltf");
+    let out = englobe(&["info", helmet.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let shown = text(&out.stdout);
+    for line in [
+        "Material_MR: metallic_roughness, base colour [1, 1, 1], metallic 1, roughness 1",
+        "normal texture Default_normal.jpg",
+        "textures:   5 (0 unreadable)",
+        "Default_albedo.jpg): 2048x2048, 3 channels, 8 bits; used as Material_MR base_color",
+        "tangents:   yes",
+    ] {
+        assert!(shown.contains(line), "{line:?} missing from:\n{shown}");
+    }
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("m.mtl"), "newmtl m\nmap_Kd lost.png\n").unwrap();
+    let obj = dir.path().join("q.obj");
+    std::fs::write(&obj, "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nusemtl m\nf 1/1 2/1 3/1\n").unwrap();
+    let shown = text(&englobe(&["info", obj.to_str().unwrap()]).stdout);
+    assert!(
+        shown.contains("textures:   1 (1 unreadable)") && shown.contains("lost.png") && shown.contains("UNREADABLE"),
+        "{shown}"
+    );
+    assert!(shown.contains("material `m`: the base colour texture"), "{shown}");
 }
 
 #[test]

@@ -1,5 +1,5 @@
 //! A digest of everything that decides an image's pixels: the scene (camera, lights, materials,
-//! every object with every vertex of its meshes) and the options of the render. Tiles record it,
+//! textures, every object with every vertex of its meshes) and the options of the render. Tiles record it,
 //! so that assembly can refuse pieces of different renders (see [`crate::tile`]).
 //!
 //! The hash is BLAKE3 (O'Connor, Aumasson, Neves and Wilcox-O'Hearn, 2020): fast enough that
@@ -29,6 +29,8 @@ pub fn scene_digest(scene: &Scene, options: &str) -> String {
     text("lights", format!("{:?}", scene.lights));
     text("materials", format!("{:?}", scene.materials));
     text("material names", format!("{:?}", scene.material_names));
+    // A texture's `Debug` names its source and sampler and carries its texels' hash.
+    text("textures", format!("{:?}", scene.textures));
     let mut meshes: HashMap<*const TriangleMesh, [u8; 32]> = HashMap::new();
     let mut mesh_digest =
         |mesh: &Arc<TriangleMesh>| *meshes.entry(Arc::as_ptr(mesh)).or_insert_with(|| hash_mesh(mesh));

@@ -88,13 +88,58 @@ pub enum ProjectionKind {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct MaterialDef {
-    pub diffuse: Option<Color>,
+    pub model: Option<MaterialModelKind>,
+    pub diffuse: Option<Spanned<Color>>,
+    pub base_color: Option<Spanned<Color>>,
     pub specular: Option<Color>,
     pub shininess: Option<NonNegative>,
     pub reflectivity: Option<Fraction>,
     pub transparency: Option<Fraction>,
     pub ior: Option<Positive>,
     pub emission: Option<Color>,
+    pub emission_strength: Option<NonNegative>,
+    pub metallic: Option<Spanned<Fraction>>,
+    pub roughness: Option<Spanned<Fraction>>,
+    pub transmission: Option<Spanned<Fraction>>,
+    pub base_color_texture: Option<Spanned<String>>,
+    pub metallic_roughness_texture: Option<Spanned<String>>,
+    pub normal_texture: Option<Spanned<String>>,
+    pub normal_scale: Option<Finite>,
+    pub emission_texture: Option<Spanned<String>>,
+    pub texture_wrap: Option<WrapKind>,
+    pub double_sided: Option<bool>,
+    pub alpha: Option<Fraction>,
+    pub alpha_mode: Option<AlphaModeKind>,
+    pub alpha_cutoff: Option<Spanned<Fraction>>,
+}
+
+/// A material's `model`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum MaterialModelKind {
+    #[default]
+    Classic,
+    MetallicRoughness,
+}
+
+/// A material's `alpha_mode`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum AlphaModeKind {
+    #[default]
+    Opaque,
+    Mask,
+    Blend,
+}
+
+/// A material's `texture_wrap`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum WrapKind {
+    #[default]
+    Repeat,
+    MirroredRepeat,
+    ClampToEdge,
 }
 
 #[derive(Debug, Deserialize)]
@@ -177,6 +222,7 @@ pub struct MeshDef {
     pub scale: Option<Scale>,
     pub matrix: Option<Matrix>,
     pub material: Option<Spanned<String>>,
+    pub smooth_angle: Option<Spanned<Finite>>,
     pub instances: Option<Vec<Spanned<TransformDef>>>,
     pub grid: Option<Spanned<GridDef>>,
 }

@@ -8,16 +8,25 @@
 pub mod error;
 pub mod format;
 pub mod framing;
+pub mod material;
+pub mod material_eval;
 pub mod mesh;
 pub mod model;
 pub mod numbers;
 pub mod overrides;
 pub mod parse;
+mod parse_material;
 mod parse_mesh;
 pub mod random_triangles;
 pub mod shared_data;
+pub mod texture;
 
 pub use error::{Located, SceneError};
+pub use material::{
+    Alpha, AlphaMode, Channel, MaterialModel, MaterialTextures, NormalEncoding, NormalMap, ScalarTexture, TextureRef,
+    UvTransform,
+};
+pub use material_eval::{MISSING_TEXTURE_COLOR, SurfaceParams};
 pub use model::{
     Camera, ImageSettings, IntegratorKind, Light, MAX_DEPTH, MAX_PIXELS, MAX_SAMPLES, Material, MaterialId, Projection,
     Scene, SceneObject,
@@ -26,3 +35,4 @@ pub use overrides::Override;
 pub use parse::{DEFAULT_MATERIAL, load_scene, load_scene_with, parse_scene, parse_scene_with};
 pub use parse_mesh::MAX_MESH_INSTANCES;
 pub use random_triangles::MAX_RANDOM_TRIANGLES;
+pub use texture::{ColorSpace, Sampler, Texture, TextureId, Wrap};

@@ -4,7 +4,11 @@
 
 use std::sync::Arc;
 
-use englobe::{Object, Vec3};
+use englobe::{Object, TriangleMesh, Vec2, Vec3};
+use glam::Vec4;
+
+pub use crate::material::Material;
+use crate::texture::Texture;
 
 /// Largest image, in pixels (2^28: a 16384 x 16384 image), refused before anything is allocated.
 pub const MAX_PIXELS: u64 = 1 << 28;
@@ -144,40 +148,6 @@ pub enum Light {
     },
 }
 
-/// Surface appearance: a Phong-style local model plus Whitted's mirror and glass terms.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Material {
-    /// Diffuse (Lambert) colour.
-    pub diffuse: Vec3,
-    /// Specular highlight colour (Blinn-Phong).
-    pub specular: Vec3,
-    /// Blinn-Phong exponent.
-    pub shininess: f32,
-    /// Fraction of light mirrored, in `0..=1`.
-    pub reflectivity: f32,
-    /// Fraction of light transmitted, in `0..=1`; `reflectivity + transparency <= 1`.
-    pub transparency: f32,
-    /// Index of refraction of the inside of a transparent object.
-    pub ior: f32,
-    /// Light emitted by the surface itself.
-    pub emission: Vec3,
-}
-
-impl Default for Material {
-    /// A matte light grey.
-    fn default() -> Self {
-        Material {
-            diffuse: Vec3::splat(0.7),
-            specular: Vec3::ZERO,
-            shininess: 32.0,
-            reflectivity: 0.0,
-            transparency: 0.0,
-            ior: 1.5,
-            emission: Vec3::ZERO,
-        }
-    }
-}
-
 /// Index into [`Scene::materials`].
 pub type MaterialId = u32;
 
@@ -192,12 +162,59 @@ pub struct SceneObject {
     /// triangle of the mesh (of the instanced mesh for an instance), which replaces `material`.
     /// Instances of one mesh share the array.
     pub triangle_materials: Option<Arc<[MaterialId]>>,
+    /// For meshes: one tangent per vertex of the mesh (of the instanced mesh for an instance,
+    /// in its own space), shared by instances: `xyz` the unit tangent along increasing `u`, `w`
+    /// the handedness (`±1`), the bitangent being `w * cross(normal, tangent)`, which points
+    /// towards decreasing `v` (the top of the image: glTF 2.0's `TANGENT` convention, and
+    /// MikkTSpace's on coordinates with `v` up). Present when the file gives tangents or a
+    /// material of the mesh has a normal map (then generated with MikkTSpace).
+    pub tangents: Option<Arc<[Vec4]>>,
 }
 
 impl SceneObject {
     /// An object with one material.
     pub fn new(object: Object, material: MaterialId) -> Self {
-        SceneObject { object, material, triangle_materials: None }
+        SceneObject { object, material, triangle_materials: None, tangents: None }
+    }
+
+    /// The mesh of a mesh or instance (in its own space for an instance).
+    fn mesh(&self) -> Option<&TriangleMesh> {
+        match &self.object {
+            Object::Mesh(m) => Some(m),
+            Object::Instance(i) => Some(i.mesh()),
+            Object::Shape(_) => None,
+        }
+    }
+
+    /// The corners of triangle `prim` and their weights at barycentric `(u, v)`, the convention
+    /// of englobe's hits (`PrimHit`, `WorldHit`): the point is `(1 - u - v) * p0 + u * p1 + v * p2`
+    /// for the triangle's vertices `[p0, p1, p2]` in file order.
+    fn corners(&self, prim: u32, u: f32, v: f32) -> Option<([u32; 3], [f32; 3])> {
+        let tri = *self.mesh()?.triangles().get(prim as usize)?;
+        Some((tri, [1.0 - u - v, u, v]))
+    }
+
+    /// The texture coordinate (set 0, glTF convention: `(0, 0)` the image's top-left corner, `v`
+    /// down; OBJ and PLY coordinates were flipped when read) at barycentric `(u, v)` of triangle
+    /// `prim`, interpolated from the vertices; `None` for shapes and meshes without coordinates.
+    pub fn uv(&self, prim: u32, u: f32, v: f32) -> Option<Vec2> {
+        let uvs = self.mesh()?.uvs()?;
+        let (tri, w) = self.corners(prim, u, v)?;
+        Some(uvs[tri[0] as usize] * w[0] + uvs[tri[1] as usize] * w[1] + uvs[tri[2] as usize] * w[2])
+    }
+
+    /// The tangent at barycentric `(u, v)` of triangle `prim` (see [`SceneObject::tangents`]):
+    /// `xyz` interpolated and normalised, in the mesh's own space (an instance's renderer moves
+    /// it by the instance's matrix, not its inverse transpose, and flips `w` when the matrix
+    /// mirrors), `w` the first corner's handedness. `None` without tangents or when the
+    /// interpolated tangent vanishes.
+    pub fn tangent(&self, prim: u32, u: f32, v: f32) -> Option<Vec4> {
+        let tangents = self.tangents.as_ref()?;
+        let (tri, w) = self.corners(prim, u, v)?;
+        let t = |k: usize| tangents.get(tri[k] as usize).copied();
+        let (a, b, c) = (t(0)?, t(1)?, t(2)?);
+        let xyz = (a.truncate() * w[0] + b.truncate() * w[1] + c.truncate() * w[2]).try_normalize()?;
+        Some(xyz.extend(if a.w < 0.0 { -1.0 } else { 1.0 }))
     }
 
     /// The material of primitive `prim` of the object (the triangle of a mesh or instance).
@@ -223,6 +240,10 @@ pub struct Scene {
     pub materials: Vec<Material>,
     /// Material names, parallel to `materials`.
     pub material_names: Vec<String>,
+    /// Textures, indexed by [`crate::TextureId`] ([`crate::TextureRef::texture`]); each image
+    /// is decoded once and shared. A texture whose file could not be read is here too, without
+    /// an image (see [`Texture::error`]), and a warning says so.
+    pub textures: Vec<Arc<Texture>>,
     /// Objects.
     pub objects: Vec<SceneObject>,
     /// What was skipped or repaired while loading (from mesh files, mostly), for the user.

@@ -2,7 +2,6 @@
 //! what a single value cannot say on its own (the camera, cross references, limits) and build the
 //! objects.
 
-use std::collections::BTreeMap;
 use std::ops::Range;
 use std::path::Path;
 
@@ -12,8 +11,8 @@ use toml::Spanned;
 use toml::de::DeTable;
 
 use crate::error::{Located, SceneError};
-use crate::format::{CameraDef, ImageDef, MaterialDef, ProjectionKind, SceneFile};
-use crate::model::{Camera, ImageSettings, Light, Material, MaterialId, Projection, Scene, SceneObject};
+use crate::format::{CameraDef, ImageDef, ProjectionKind, SceneFile};
+use crate::model::{Camera, ImageSettings, Light, MaterialId, Projection, Scene, SceneObject};
 use crate::overrides::{Override, Placed};
 
 /// Name of the material objects get when they name none.
@@ -95,7 +94,8 @@ impl Converter<'_> {
     fn scene(&self, def: SceneFile) -> Result<Scene, SceneError> {
         let image = self.image(def.image)?;
         let camera = self.camera(def.camera)?;
-        let (materials, material_names) = self.materials(def.materials)?;
+        let mut warnings = Vec::new();
+        let (materials, material_names, textures) = self.materials(def.materials, &mut warnings)?;
         let lookup = |m: &Option<Spanned<String>>| -> Result<MaterialId, SceneError> {
             let Some(m) = m else { return Ok(0) };
             material_names.iter().position(|n| n == m.get_ref()).map(|i| i as MaterialId).ok_or_else(|| {
@@ -174,7 +174,7 @@ impl Converter<'_> {
             let material = lookup(&r.get_ref().material)?;
             push(self.random_triangles(r)?, material);
         }
-        let mut scene = Scene { image, camera, lights, materials, material_names, objects, warnings: Vec::new() };
+        let mut scene = Scene { image, camera, lights, materials, material_names, textures, objects, warnings };
         self.meshes(def.mesh, &mut scene)?;
         Ok(scene)
     }
@@ -258,44 +258,6 @@ impl Converter<'_> {
             lens_radius: c.aperture.map_or(0.0, |a| a.0 * 0.5),
             focus_distance: c.focus_distance.map_or(distance, |f| f.0),
         })
-    }
-
-    fn materials(
-        &self,
-        defs: BTreeMap<String, Spanned<MaterialDef>>,
-    ) -> Result<(Vec<Material>, Vec<String>), SceneError> {
-        let mut materials = vec![Material::default()];
-        let mut names = vec![DEFAULT_MATERIAL.to_owned()];
-        for (name, def) in defs {
-            let span = def.span();
-            let d = def.into_inner();
-            let base = Material::default();
-            let m = Material {
-                diffuse: d.diffuse.map_or(base.diffuse, |c| c.0),
-                specular: d.specular.map_or(base.specular, |c| c.0),
-                shininess: d.shininess.map_or(base.shininess, |x| x.0),
-                reflectivity: d.reflectivity.map_or(base.reflectivity, |x| x.0),
-                transparency: d.transparency.map_or(base.transparency, |x| x.0),
-                ior: d.ior.map_or(base.ior, |x| x.0),
-                emission: d.emission.map_or(base.emission, |c| c.0),
-            };
-            if m.reflectivity + m.transparency > 1.0 {
-                return Err(self.err(
-                    span,
-                    format!(
-                        "material `{name}`: reflectivity + transparency is {}, expected at most 1",
-                        m.reflectivity + m.transparency
-                    ),
-                ));
-            }
-            if name == DEFAULT_MATERIAL {
-                materials[0] = m;
-            } else {
-                materials.push(m);
-                names.push(name);
-            }
-        }
-        Ok((materials, names))
     }
 }
 

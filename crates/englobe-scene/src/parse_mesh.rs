@@ -11,12 +11,12 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 use englobe::{Affine3A, Instance, Object, TriangleMesh, Vec3};
-use glam::{EulerRot, Quat};
+use glam::{EulerRot, Quat, Vec4};
 use toml::Spanned;
 
 use crate::error::{Located, SceneError};
 use crate::format::{GridDef, MeshDef, TransformDef};
-use crate::mesh::{NO_MATERIAL, bake_transform, load_mesh_file};
+use crate::mesh::{MeshOptions, NO_MATERIAL, bake_transform, load_mesh_file_with, transform_tangents};
 use crate::model::{MaterialId, Scene, SceneObject};
 use crate::numbers::{Matrix, Point, Scale};
 use crate::parse::Converter;
@@ -29,13 +29,16 @@ struct Cached {
     mesh: Arc<TriangleMesh>,
     /// Scene material of each triangle, when the file gives materials.
     triangle_materials: Option<Arc<[MaterialId]>>,
+    /// Per-vertex tangents, when the file gives them or a normal map needs them.
+    tangents: Option<Arc<[Vec4]>>,
 }
 
 impl Converter<'_> {
     /// Loads every `[[mesh]]` entry into `scene`.
     pub(crate) fn meshes(&self, defs: Vec<Spanned<MeshDef>>, scene: &mut Scene) -> Result<(), SceneError> {
         let scene_materials = scene.material_names.len();
-        let mut cache: HashMap<PathBuf, Cached> = HashMap::new();
+        // A file is read once per smoothing angle and need of tangents (what is generated differs).
+        let mut cache: HashMap<(PathBuf, u32, bool), Cached> = HashMap::new();
         for def in defs {
             let entry_span = def.span();
             let d = def.into_inner();
@@ -61,9 +64,25 @@ impl Converter<'_> {
             )?;
 
             let file = self.dir.join(d.path.get_ref());
-            let key = std::fs::canonicalize(&file).unwrap_or_else(|_| file.clone());
+            let want_tangents =
+                override_material.is_some_and(|m| scene.materials[m as usize].textures.normal.is_some());
+            let options = MeshOptions {
+                smooth_angle: d.smooth_angle.as_ref().map_or(MeshOptions::default().smooth_angle, |a| a.get_ref().0),
+                want_tangents,
+            };
+            if let Some(a) = &d.smooth_angle {
+                if !(0.0..=180.0).contains(&a.get_ref().0) {
+                    return Err(self
+                        .err(a.span(), format!("a smoothing angle of {} degrees: expected 0 to 180", a.get_ref().0)));
+                }
+            }
+            let key = (
+                std::fs::canonicalize(&file).unwrap_or_else(|_| file.clone()),
+                options.smooth_angle.to_bits(),
+                want_tangents,
+            );
             if !cache.contains_key(&key) {
-                let loaded = load_mesh_file(&file).map_err(|mesh| SceneError::Mesh {
+                let loaded = load_mesh_file_with(&file, &options).map_err(|mesh| SceneError::Mesh {
                     located: located(
                         self,
                         d.path.span(),
@@ -74,39 +93,51 @@ impl Converter<'_> {
                 scene.warnings.extend(loaded.warnings.iter().map(|w| format!("{}: {w}", file.display())));
                 let stem = file.file_name().map_or(String::new(), |n| n.to_string_lossy().into_owned());
                 let first = scene.materials.len() as MaterialId;
+                let first_texture = scene.textures.len() as crate::TextureId;
+                scene.textures.extend(loaded.textures.iter().cloned());
                 for (name, material) in &loaded.materials {
-                    scene.materials.push(material.clone());
+                    let mut material = material.clone();
+                    material.textures = material.textures.shifted(first_texture);
+                    scene.materials.push(material);
                     scene.material_names.push(format!("{stem}:{name}"));
                 }
                 let triangle_materials = loaded.triangle_materials.as_ref().map(|ids| {
                     ids.iter().map(|&m| if m == NO_MATERIAL { 0 } else { first + m }).collect::<Arc<[MaterialId]>>()
                 });
-                cache.insert(key.clone(), Cached { mesh: Arc::new(loaded.mesh), triangle_materials });
+                let tangents = loaded.tangents.map(Arc::from);
+                cache.insert(key.clone(), Cached { mesh: Arc::new(loaded.mesh), triangle_materials, tangents });
             }
             let cached = &cache[&key];
             let (material, triangle_materials) = match override_material {
                 Some(m) => (m, None),
                 None => (0, cached.triangle_materials.clone()),
             };
-            let mut push = |object: Object| {
-                scene.objects.push(SceneObject { object, material, triangle_materials: triangle_materials.clone() })
+            let mut push = |object: Object, tangents: Option<Arc<[Vec4]>>| {
+                scene.objects.push(SceneObject {
+                    object,
+                    material,
+                    triangle_materials: triangle_materials.clone(),
+                    tangents,
+                })
             };
 
             let instances = self.instances(&d.instances, &d.grid, entry_span.clone())?;
             match instances {
                 None => {
-                    let mesh = if placement == Affine3A::IDENTITY {
-                        cached.mesh.clone()
+                    let (mesh, tangents) = if placement == Affine3A::IDENTITY {
+                        (cached.mesh.clone(), cached.tangents.clone())
                     } else {
-                        Arc::new(bake_transform(&cached.mesh, &placement).map_err(|e| self.err(entry_span.clone(), e))?)
+                        let mesh =
+                            bake_transform(&cached.mesh, &placement).map_err(|e| self.err(entry_span.clone(), e))?;
+                        (Arc::new(mesh), cached.tangents.as_ref().map(|t| Arc::from(transform_tangents(t, &placement))))
                     };
-                    push(Object::Mesh(mesh));
+                    push(Object::Mesh(mesh), tangents);
                 }
                 Some(list) => {
                     for (transform, span) in list {
                         let instance = Instance::new(cached.mesh.clone(), transform * placement)
                             .map_err(|e| self.err(span, format!("this instance cannot be placed: {e}")))?;
-                        push(Object::Instance(instance));
+                        push(Object::Instance(instance), cached.tangents.clone());
                     }
                 }
             }

@@ -214,3 +214,50 @@ fn random_triangles_are_checked_and_generated() {
     assert_eq!(s.objects[1].material, 1);
     assert_eq!(s.objects, again.objects);
 }
+
+#[test]
+fn material_model_keys() {
+    let red = "diffuse = [0.8, 0.1, 0.1]";
+    check(
+        red,
+        "diffuse = [0.8, 0.1, 0.1]\nmetallic = 0.5",
+        "0.5",
+        "`metallic` belongs to `model = \"metallic_roughness\"`",
+    );
+    check(red, "diffuse = [0.8, 0.1, 0.1]\nroughness = 0.2", "0.2", "`roughness` belongs to");
+    check(red, "diffuse = [0.8, 0.1, 0.1]\nbase_color = [1, 1, 1]", "[1, 1, 1]", "`base_color` and `diffuse`");
+    check(red, "diffuse = [0.8, 0.1, 0.1]\nalpha_cutoff = 0.3", "0.3", "needs `alpha_mode = \"mask\"`");
+    check(red, "model = \"pbr\"", "\"pbr\"", "unknown variant `pbr`");
+    check(red, "model = \"metallic_roughness\"\nmetallic = 1.5", "1.5", "between 0 and 1");
+    check(red, "alpha_mode = \"cutout\"", "\"cutout\"", "unknown variant `cutout`");
+    check(red, "texture_wrap = \"clamp\"", "\"clamp\"", "unknown variant `clamp`");
+    check(red, "base_color_texture = 3", "3", "expected a string");
+}
+
+#[test]
+fn metallic_roughness_materials_and_their_defaults() {
+    let text = GOOD.replacen(
+        "diffuse = [0.8, 0.1, 0.1]",
+        "model = \"metallic_roughness\"\nbase_color = [0.8, 0.1, 0.1]\nroughness = 0.25\nemission = [1, 0.5, 0]\n\
+         emission_strength = 2\nalpha_mode = \"mask\"\ndouble_sided = false\nbase_color_texture = \"nowhere.png\"",
+        1,
+    );
+    let s = parse_scene(&text, "good.toml".as_ref()).unwrap();
+    let m = &s.materials[1];
+    assert_eq!(
+        m.model,
+        englobe_scene::MaterialModel::MetallicRoughness { metallic: 1.0, roughness: 0.25, transmission: 0.0 }
+    );
+    assert_eq!((m.diffuse, m.emission), (englobe::Vec3::new(0.8, 0.1, 0.1), englobe::Vec3::new(2.0, 1.0, 0.0)));
+    assert_eq!((m.alpha.mode, m.double_sided), (englobe_scene::AlphaMode::Mask { cutoff: 0.5 }, false));
+    // The missing texture is a warning and a texture without an image, not an error.
+    assert_eq!(s.textures.len(), 1);
+    assert!(s.textures[0].image.is_none());
+    assert!(s.warnings[0].contains("material `red`") && s.warnings[0].contains("nowhere.png"), "{:?}", s.warnings);
+    // The classic default is unchanged.
+    let d = &s.materials[0];
+    assert_eq!(
+        (d.model, d.double_sided, d.alpha.mode),
+        (englobe_scene::MaterialModel::Classic, true, englobe_scene::AlphaMode::Opaque)
+    );
+}

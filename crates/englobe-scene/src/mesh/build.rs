@@ -5,10 +5,14 @@
 
 use std::path::Path;
 
+use std::sync::Arc;
+
 use englobe::{TriangleMesh, Vec2, Vec3};
+use glam::Vec4;
 
 use super::error::{MeshErrorKind, MeshFileError};
 use super::loaded::{LoadedMesh, MeshFormat, NO_MATERIAL, NamedMaterial};
+use crate::texture::Texture;
 
 /// A mesh as a loader produced it, before the common checks.
 #[derive(Debug, Default)]
@@ -17,6 +21,7 @@ pub(super) struct MeshParts {
     pub triangles: Vec<[u32; 3]>,
     pub normals: Option<Vec<Vec3>>,
     pub uvs: Option<Vec<Vec2>>,
+    pub tangents: Option<Vec<Vec4>>,
     /// One per triangle, indexing the materials or [`NO_MATERIAL`].
     pub triangle_materials: Option<Vec<u32>>,
 }
@@ -26,7 +31,7 @@ pub(super) fn finish(
     path: &Path,
     format: MeshFormat,
     mut parts: MeshParts,
-    materials: Vec<NamedMaterial>,
+    (materials, textures): (Vec<NamedMaterial>, Vec<Arc<Texture>>),
     mut warnings: Vec<String>,
 ) -> Result<LoadedMesh, MeshFileError> {
     let file_err = |kind| MeshFileError::file(path, kind);
@@ -71,6 +76,13 @@ pub(super) fn finish(
         }
     }
 
+    if let Some(t) = &parts.tangents {
+        if t.len() != vertices || t.iter().any(|v| !v.is_finite()) {
+            warnings.push(format!("{} tangents for {vertices} vertices; they are dropped", t.len()));
+            parts.tangents = None;
+        }
+    }
+
     let dropped = drop_degenerate(&parts.positions, &mut parts.triangles, parts.triangle_materials.as_mut());
     if dropped > 0 {
         warnings
@@ -92,7 +104,15 @@ pub(super) fn finish(
     if let Some(uv) = parts.uvs {
         mesh = mesh.with_uvs(uv).map_err(to_err)?;
     }
-    Ok(LoadedMesh { mesh, materials, triangle_materials: parts.triangle_materials, warnings, format })
+    Ok(LoadedMesh {
+        mesh,
+        materials,
+        textures,
+        tangents: parts.tangents,
+        triangle_materials: parts.triangle_materials,
+        warnings,
+        format,
+    })
 }
 
 /// Removes the triangles of zero area (two equal indices, or three points on one line as
@@ -139,7 +159,7 @@ mod tests {
         let mut m = parts(p, vec![[0, 1, 2], [0, 1, 3], [1, 1, 2], [2, 1, 0]]);
         m.triangle_materials = Some(vec![0, 1, 2, 3]);
         let mats = (0..4).map(|i| (i.to_string(), Default::default())).collect();
-        let loaded = finish(Path::new("m"), MeshFormat::Obj, m, mats, vec![]).unwrap();
+        let loaded = finish(Path::new("m"), MeshFormat::Obj, m, (mats, vec![]), vec![]).unwrap();
         assert_eq!(loaded.mesh.triangles(), &[[0, 1, 2], [2, 1, 0]]);
         assert_eq!(loaded.triangle_materials, Some(vec![0, 3]));
         assert_eq!(loaded.warnings, vec!["dropped 2 degenerate triangles (zero area)".to_owned()]);
@@ -149,22 +169,22 @@ mod tests {
     fn nothing_unchecked_gets_through() {
         let nan = parts(vec![Vec3::new(f32::NAN, 0.0, 0.0), Vec3::X, Vec3::Y], vec![[0, 1, 2]]);
         assert!(matches!(
-            finish(Path::new("m"), MeshFormat::Obj, nan, vec![], vec![]).unwrap_err().kind,
+            finish(Path::new("m"), MeshFormat::Obj, nan, (vec![], vec![]), vec![]).unwrap_err().kind,
             MeshErrorKind::NonFinite { .. }
         ));
         let far = parts(vec![Vec3::ZERO, Vec3::X, Vec3::Y], vec![[0, 1, 3]]);
         assert!(matches!(
-            finish(Path::new("m"), MeshFormat::Obj, far, vec![], vec![]).unwrap_err().kind,
+            finish(Path::new("m"), MeshFormat::Obj, far, (vec![], vec![]), vec![]).unwrap_err().kind,
             MeshErrorKind::IndexOutOfRange { .. }
         ));
         let flat = parts(vec![Vec3::ZERO, Vec3::X, Vec3::X * 3.0], vec![[0, 1, 2]]);
         assert!(matches!(
-            finish(Path::new("m"), MeshFormat::Obj, flat, vec![], vec![]).unwrap_err().kind,
+            finish(Path::new("m"), MeshFormat::Obj, flat, (vec![], vec![]), vec![]).unwrap_err().kind,
             MeshErrorKind::NoTriangles(_)
         ));
         let mut short = parts(vec![Vec3::ZERO, Vec3::X, Vec3::Y], vec![[0, 1, 2]]);
         short.normals = Some(vec![Vec3::Z]);
-        let loaded = finish(Path::new("m"), MeshFormat::Obj, short, vec![], vec![]).unwrap();
+        let loaded = finish(Path::new("m"), MeshFormat::Obj, short, (vec![], vec![]), vec![]).unwrap();
         assert!(loaded.mesh.normals().is_none() && loaded.warnings.len() == 1);
     }
 }

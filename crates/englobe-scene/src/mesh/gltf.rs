@@ -1,7 +1,7 @@
 //! glTF 2.0 files (Khronos Group 2017, "glTF 2.0 Specification"), `.gltf` with its buffers and
 //! `.glb`: every mesh primitive of the default scene, with node transforms applied, becomes part
-//! of one triangle mesh; a material's base colour factor becomes its diffuse colour and its
-//! emissive factor its emission. Textures are not read.
+//! of one triangle mesh; materials and their textures are read by [`super::gltf_material`].
+//! Vertex tangents (`TANGENT`) are kept when every primitive has them.
 //!
 //! The `gltf` crate parses the JSON into its document model; englobe does the rest: the GLB
 //! container (whose header the crate subtracts from without checking), the required extensions
@@ -13,7 +13,7 @@
 use std::path::Path;
 
 use englobe::{Vec2, Vec3};
-use glam::{Mat3, Mat4, Quat};
+use glam::{Mat3, Mat4, Quat, Vec4};
 use gltf::json;
 use gltf::json::accessor::{ComponentType, Type};
 use gltf::json::mesh::{Mode, Semantic};
@@ -22,9 +22,8 @@ use gltf::json::validation::Checked;
 use super::build::{MeshParts, finish};
 use super::error::{MeshErrorKind, MeshFileError, Position};
 use super::gltf_data::Buffers;
-use super::loaded::{LoadedMesh, MeshFormat, NO_MATERIAL, NamedMaterial};
+use super::loaded::{LoadedMesh, MeshFormat, NO_MATERIAL};
 use super::read::guarded;
-use crate::model::Material;
 
 /// Most node instances a scene may expand to (a node reachable along many paths counts once per
 /// path).
@@ -63,25 +62,29 @@ pub(super) fn load(path: &Path, bytes: &[u8], format: MeshFormat) -> Result<Load
             ));
         }
     }
-    let materials = materials(&root);
+    let mut buffers = Buffers::new(path, &root, bin);
+    let read = super::gltf_material::materials(path, &root, &mut buffers);
     let mut builder = Builder {
         path,
         root: &root,
-        buffers: Buffers::new(path, &root, bin),
+        buffers,
         parts: MeshParts::default(),
         normals: Vec::new(),
         uvs: Vec::new(),
+        tangents: Vec::new(),
         ids: Vec::new(),
         all_normals: true,
         all_uvs: true,
-        warnings: Vec::new(),
+        all_tangents: true,
+        warnings: read.warnings,
     };
     for (node, transform) in scene_nodes(path, &root)? {
         if let Some(mesh) = root.nodes[node].mesh {
             builder.add_mesh(node, mesh.value(), &transform)?;
         }
     }
-    let Builder { mut parts, mut warnings, normals, uvs, ids, all_normals, all_uvs, .. } = builder;
+    let Builder { mut parts, mut warnings, normals, uvs, tangents, ids, all_normals, all_uvs, all_tangents, .. } =
+        builder;
     if parts.positions.is_empty() {
         return Err(MeshFileError::file(path, MeshErrorKind::NoTriangles(" in the default scene".into())));
     }
@@ -90,8 +93,9 @@ pub(super) fn load(path: &Path, bytes: &[u8], format: MeshFormat) -> Result<Load
     }
     parts.normals = (all_normals && !normals.is_empty()).then_some(normals);
     parts.uvs = (all_uvs && !uvs.is_empty()).then_some(uvs);
+    parts.tangents = (all_tangents && all_normals && !tangents.is_empty()).then_some(tangents);
     parts.triangle_materials = Some(ids);
-    finish(path, format, parts, materials, warnings)
+    finish(path, format, parts, (read.materials, read.textures), warnings)
 }
 
 /// The JSON chunk and the optional binary chunk of a GLB container.
@@ -145,30 +149,6 @@ fn split_glb<'a>(path: &Path, bytes: &'a [u8]) -> Result<(&'a [u8], Option<&'a [
     }
     let json = json.ok_or_else(|| short(12, "the file has no JSON chunk"))?;
     Ok((json, bin))
-}
-
-/// englobe's materials for the document's: base colour factor as diffuse, emissive factor as
-/// emission. Textures are not read; an emissive factor that only scales an emissive texture
-/// (which then says where the surface glows) is dropped rather than lighting the whole surface.
-fn materials(root: &json::Root) -> Vec<NamedMaterial> {
-    root.materials
-        .iter()
-        .enumerate()
-        .map(|(i, m)| {
-            let [r, g, b, _] = m.pbr_metallic_roughness.base_color_factor.0;
-            let finite = |v: Vec3| if v.is_finite() { v.max(Vec3::ZERO) } else { Vec3::ZERO };
-            let material = Material {
-                diffuse: finite(Vec3::new(r, g, b)),
-                emission: if m.emissive_texture.is_some() {
-                    Vec3::ZERO
-                } else {
-                    finite(Vec3::from(m.emissive_factor.0))
-                },
-                ..Material::default()
-            };
-            (m.name.clone().unwrap_or_else(|| format!("material {i}")), material)
-        })
-        .collect()
 }
 
 /// Every node of the default scene (or, without scenes, every root node) with its transform to
@@ -257,9 +237,11 @@ struct Builder<'a> {
     parts: MeshParts,
     normals: Vec<Vec3>,
     uvs: Vec<Vec2>,
+    tangents: Vec<Vec4>,
     ids: Vec<u32>,
     all_normals: bool,
     all_uvs: bool,
+    all_tangents: bool,
     warnings: Vec<String>,
 }
 
@@ -307,6 +289,21 @@ impl Builder<'_> {
                     self.normals.extend(normals.iter().map(|n| (normal_matrix * Vec3::from(*n)).normalize_or_zero()));
                 }
                 _ => self.all_normals = false,
+            }
+            match prim.attributes.get(&Checked::Valid(Semantic::Tangents)) {
+                Some(t) if self.all_tangents => {
+                    let acc = self.buffers.accessor(root, t.value(), "TANGENT", &[Type::Vec4], &f32_only)?;
+                    check_count(path, &at, "TANGENT", acc.count, count)?;
+                    // Tangents move with the surface (not the inverse transpose); a mirroring
+                    // transform flips the bitangent, so the handedness flips with it.
+                    let linear = Mat3::from_mat4(*transform);
+                    let flip = if linear.determinant() < 0.0 { -1.0 } else { 1.0 };
+                    self.tangents.extend(acc.vectors::<4>(path, "a tangent")?.into_iter().map(|t| {
+                        let xyz = (linear * Vec3::new(t[0], t[1], t[2])).normalize_or_zero();
+                        xyz.extend(if t[3] < 0.0 { -flip } else { flip })
+                    }));
+                }
+                _ => self.all_tangents = false,
             }
             match prim.attributes.get(&Checked::Valid(Semantic::TexCoords(0))) {
                 Some(t) if self.all_uvs => {

@@ -109,6 +109,34 @@ impl<'a> Buffers<'a> {
         Ok(self.loaded[index].as_deref().unwrap_or(&[]))
     }
 
+    /// The bytes of buffer view `index` (an image's), checked against its buffer.
+    pub(super) fn view(&mut self, root: &json::Root, index: usize) -> Result<&[u8], MeshFileError> {
+        let path = self.path;
+        let Some(view) = root.buffer_views.get(index) else {
+            return Err(json_err(
+                path,
+                format!("bufferViews[{index}]"),
+                MeshErrorKind::Malformed("no such buffer view".into()),
+            ));
+        };
+        let start = view.byte_offset.map_or(0, |o| o.0) as u128;
+        let end = start + view.byte_length.0 as u128;
+        let buffer_index = view.buffer.value();
+        let declared = root.buffers.get(buffer_index).map_or(0, |b| b.byte_length.0) as u128;
+        if end > declared {
+            return Err(json_err(
+                path,
+                format!("bufferViews[{index}]"),
+                MeshErrorKind::Malformed(format!(
+                    "the view covers bytes {start}..{end} of buffers[{buffer_index}], which has {declared}"
+                )),
+            ));
+        }
+        let data = self.buffer(root, buffer_index)?;
+        // `buffer` holds at least the declared length, which `end` does not pass.
+        Ok(&data[start as usize..end as usize])
+    }
+
     /// Accessor `index`, checked, if its type is one of `types` and its component one of
     /// `components` (`what` names its use in errors).
     pub(super) fn accessor(
@@ -271,7 +299,7 @@ impl Accessor<'_> {
 }
 
 /// Decodes standard base64 (with or without padding).
-fn decode_base64(text: &str) -> Result<Vec<u8>, String> {
+pub(super) fn decode_base64(text: &str) -> Result<Vec<u8>, String> {
     let mut out = Vec::with_capacity(text.len() / 4 * 3);
     let (mut acc, mut bits) = (0u32, 0u32);
     for (i, c) in text.bytes().enumerate() {
@@ -295,7 +323,7 @@ fn decode_base64(text: &str) -> Result<Vec<u8>, String> {
 }
 
 /// `%20` and friends in relative URIs.
-fn percent_decode(uri: &str) -> String {
+pub(super) fn percent_decode(uri: &str) -> String {
     let bytes = uri.as_bytes();
     let mut out = Vec::with_capacity(bytes.len());
     let mut i = 0;

@@ -3,9 +3,13 @@
 
 use std::path::Path;
 
+use std::sync::Arc;
+
 use englobe::TriangleMesh;
+use glam::Vec4;
 
 use crate::model::Material;
+use crate::texture::Texture;
 
 /// Largest mesh file read (whole, into memory).
 pub const MAX_MESH_FILE_BYTES: u64 = 2 << 30;
@@ -60,8 +64,14 @@ impl MeshFormat {
 pub struct LoadedMesh {
     /// The triangles, degenerate ones dropped.
     pub mesh: TriangleMesh,
-    /// Materials the file defines (OBJ's MTL libraries, glTF's materials), in file order.
+    /// Materials the file defines (OBJ's MTL libraries, glTF's materials), in file order; their
+    /// texture references index `textures`.
     pub materials: Vec<NamedMaterial>,
+    /// Textures the materials use (those that could not be read included, without an image).
+    pub textures: Vec<Arc<Texture>>,
+    /// One tangent per vertex (see [`crate::SceneObject::tangents`] for the convention), from
+    /// the file or generated for normal maps.
+    pub tangents: Option<Vec<Vec4>>,
     /// For each triangle, an index into `materials` or [`NO_MATERIAL`]; `None` when no triangle
     /// has a material of its own.
     pub triangle_materials: Option<Vec<u32>>,

@@ -8,14 +8,20 @@ mod build;
 pub mod error;
 mod gltf;
 mod gltf_data;
+mod gltf_material;
 mod loaded;
 mod mtl;
+mod mtl_map;
+mod mtl_material;
 mod obj;
 mod obj_scan;
 mod ply;
 mod ply_body;
 mod ply_header;
+mod prepare;
 mod read;
+mod smooth_normals;
+mod tangents;
 mod transform;
 mod triangulate;
 
@@ -23,13 +29,27 @@ use std::path::Path;
 
 pub use error::{MeshErrorKind, MeshFileError, Position};
 pub use loaded::{LoadedMesh, MAX_MESH_FILE_BYTES, MAX_MTL_FILE_BYTES, MeshFormat, NO_MATERIAL, NamedMaterial};
-pub use transform::bake_transform;
+pub use prepare::{DEFAULT_SMOOTH_ANGLE, MeshOptions};
+pub use transform::{bake_transform, transform_tangents};
 
-pub(crate) use read::read_at_most;
-use read::{check_file, read_limited};
+use read::check_file;
+pub(crate) use read::{guarded, read_at_most, read_limited};
 
-/// Reads and checks the mesh file `path`, choosing the format by its extension.
+/// Reads and checks the mesh file `path`, choosing the format by its extension, and prepares it
+/// for shading with the default [`MeshOptions`].
 pub fn load_mesh_file(path: &Path) -> Result<LoadedMesh, MeshFileError> {
+    load_mesh_file_with(path, &MeshOptions::default())
+}
+
+/// [`load_mesh_file`] with `options`: smooth normals for meshes without any, tangents for normal
+/// maps.
+pub fn load_mesh_file_with(path: &Path, options: &MeshOptions) -> Result<LoadedMesh, MeshFileError> {
+    let mut loaded = read_mesh_file(path)?;
+    prepare::prepare(&mut loaded, options);
+    Ok(loaded)
+}
+
+fn read_mesh_file(path: &Path) -> Result<LoadedMesh, MeshFileError> {
     check_file(path, MAX_MESH_FILE_BYTES)?;
     let Some(format) = MeshFormat::from_path(path) else {
         let ext = path.extension().map_or(String::new(), |e| e.to_string_lossy().into_owned());
@@ -48,8 +68,16 @@ pub fn load_mesh_file(path: &Path) -> Result<LoadedMesh, MeshFileError> {
     load_mesh_bytes(path, format, bytes)
 }
 
-/// Reads and checks a mesh already in memory. `path` names it in errors, and files it refers to
-/// (an OBJ's material libraries, a glTF's buffers) are looked for beside it.
+/// Checks the text of an MTL material library as OBJ loading does (every statement, texture
+/// statements and their options included), without reading the textures; `path` names it in
+/// errors.
+pub fn check_mtl_text(path: &Path, text: &str) -> Result<(), MeshFileError> {
+    mtl::scan(path, text).map(|_| ())
+}
+
+/// Reads and checks a mesh already in memory, as it is in the file (no normals or tangents
+/// generated). `path` names it in errors, and files it refers to (an OBJ's material libraries,
+/// a glTF's buffers and images) are looked for beside it.
 pub fn load_mesh_bytes(path: &Path, format: MeshFormat, bytes: Vec<u8>) -> Result<LoadedMesh, MeshFileError> {
     match format {
         MeshFormat::Obj => obj::load(path, bytes),

@@ -1,29 +1,28 @@
 //! MTL material libraries: englobe's line-by-line check of what `tobj` will parse (it panicked on
-//! `Kd 0.5 0.5` up to version 4.0.4, and reports other mistakes without a line), and the mapping
-//! of MTL's parameters onto englobe's Whitted materials.
-//!
-//! The mapping, documented in `docs/scene-format.md`:
-//!
-//! | MTL | englobe |
-//! |---|---|
-//! | `Kd` | `diffuse` |
-//! | `Ks` | `specular` (none under `illum` 0 and 1, which have no highlight) |
-//! | `Ns` | `shininess` |
-//! | `Ni` | `ior` (values not above 0 keep the default) |
-//! | `d`, or `Tr` = 1 - `d` when `d` is absent | `transparency = 1 - d` |
-//! | `Ke` | `emission` |
-//! | `illum` 3 to 7 (ray-traced reflection) | `reflectivity` = largest component of `Ks`, at most `1 - transparency` |
+//! `Kd 0.5 0.5` up to version 4.0.4, and reports other mistakes without a line), which also
+//! reads the texture statements with their options ([`super::mtl_map`]), and the mapping of MTL's
+//! parameters onto englobe's materials ([`super::mtl_material`]).
 
+use std::collections::HashMap;
 use std::path::Path;
 
-use englobe::Vec3;
-
 use super::error::{MeshErrorKind, MeshFileError};
-use crate::model::Material;
+use super::mtl_map::{MapStatement, parse_map};
+
+/// The texture statements of each material of a library, by material name, with their keywords.
+pub(super) type MtlMaps = HashMap<String, Vec<(String, MapStatement)>>;
+
+/// The texture statements englobe reads (and those it reads only to check them).
+const MAP_KEYWORDS: &[&str] = &[
+    "map_Ka", "map_Kd", "map_Ks", "map_Ke", "map_Ns", "map_ns", "map_NS", "map_d", "map_Bump", "map_bump", "bump",
+    "norm", "disp", "decal", "refl", "map_Pr", "map_Pm",
+];
 
 /// Checks the MTL text `text` of `path` statement by statement, refusing what `tobj` would fail
-/// or panic on.
-pub(super) fn scan(path: &Path, text: &str) -> Result<(), MeshFileError> {
+/// or panic on, and returns the texture statements of each material.
+pub(super) fn scan(path: &Path, text: &str) -> Result<MtlMaps, MeshFileError> {
+    let mut maps = MtlMaps::new();
+    let mut current: Option<String> = None;
     for (index, raw) in text.lines().enumerate() {
         let err = |kind| MeshFileError::line(path, index + 1, kind);
         let line = raw.trim();
@@ -34,6 +33,7 @@ pub(super) fn scan(path: &Path, text: &str) -> Result<(), MeshFileError> {
             "newmtl" if rest.is_empty() => {
                 return Err(err(MeshErrorKind::Arity { keyword: keyword.into(), expected: "a name", found: 0 }));
             }
+            "newmtl" => current = Some(rest.to_owned()),
             "Ka" | "Kd" | "Ks" | "Ke" => {
                 // Up to three numbers; `tobj` ignores what follows (often a comment).
                 let mut n = 0;
@@ -86,55 +86,23 @@ pub(super) fn scan(path: &Path, text: &str) -> Result<(), MeshFileError> {
                     }));
                 }
             }
-            "map_Ka" | "map_Kd" | "map_Ks" | "map_Bump" | "map_bump" | "map_Ns" | "map_ns" | "map_NS" | "bump"
-            | "map_d"
-                if rest.is_empty() =>
-            {
-                return Err(err(MeshErrorKind::Arity {
-                    keyword: keyword.into(),
-                    expected: "a texture file name",
-                    found: 0,
-                }));
+            k if MAP_KEYWORDS.contains(&k) => {
+                let map = parse_map(rest).map_err(|e| err(MeshErrorKind::Malformed(format!("`{keyword}` {e}"))))?;
+                if let Some(name) = &current {
+                    maps.entry(name.clone()).or_default().push((keyword.to_owned(), map));
+                }
             }
             _ => {}
         }
     }
-    Ok(())
-}
-
-/// englobe's material for a checked MTL material.
-pub(super) fn to_material(m: &tobj::Material) -> Material {
-    let base = Material::default();
-    let color = |c: Option<[f32; 3]>, default: Vec3| c.map_or(default, |c| Vec3::from(c).max(Vec3::ZERO));
-    let illum = m.illumination_model;
-    let specular = match illum {
-        Some(0) | Some(1) => Vec3::ZERO,
-        _ => color(m.specular, base.specular),
-    };
-    // `Tr` is what `tobj` keeps as an unknown parameter; `scan` checked that it is a number.
-    let tr = m.unknown_param.get("Tr").and_then(|t| t.split_whitespace().next()?.parse::<f32>().ok());
-    let dissolve = m.dissolve.or(tr.map(|t| 1.0 - t)).unwrap_or(1.0);
-    let transparency = (1.0 - dissolve).clamp(0.0, 1.0);
-    let reflectivity = match illum {
-        Some(3..=7) => specular.max_element().clamp(0.0, 1.0 - transparency),
-        _ => 0.0,
-    };
-    Material {
-        diffuse: color(m.diffuse, base.diffuse),
-        specular,
-        shininess: m.shininess.filter(|s| *s >= 0.0).unwrap_or(base.shininess),
-        reflectivity,
-        transparency,
-        ior: m.optical_density.filter(|n| *n > 0.0).unwrap_or(base.ior),
-        emission: color(m.emissive, Vec3::ZERO),
-    }
+    Ok(maps)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    fn check(text: &str) -> Result<(), MeshFileError> {
+    fn check(text: &str) -> Result<MtlMaps, MeshFileError> {
         scan(Path::new("t.mtl"), text)
     }
 
@@ -161,16 +129,14 @@ mod tests {
     }
 
     #[test]
-    fn mapping_follows_the_table() {
-        let text = "newmtl glass\nKd 0.1 0.2 0.3\nKs 0.9 0.8 0.7\nNs 50\nNi 1.33\nTr 0.25\nillum 7\nKe 0 1 0\n";
-        let (mats, _) = tobj::load_mtl_buf(&mut text.as_bytes()).unwrap();
-        let m = to_material(&mats[0]);
-        assert_eq!(m.diffuse, Vec3::new(0.1, 0.2, 0.3));
-        assert_eq!((m.shininess, m.ior, m.transparency), (50.0, 1.33, 0.25));
-        assert_eq!(m.reflectivity, 0.75, "Ks 0.9, capped at 1 - transparency");
-        assert_eq!(m.emission, Vec3::Y);
-        let (mats, _) = tobj::load_mtl_buf(&mut "newmtl m\nKs 1 1 1\nillum 1\nd 1\nTr 0.5\n".as_bytes()).unwrap();
-        let m = to_material(&mats[0]);
-        assert_eq!((m.specular, m.transparency, m.reflectivity), (Vec3::ZERO, 0.0, 0.0), "d wins over Tr");
+    fn texture_statements_are_kept_by_material() {
+        let maps = check("newmtl a\nmap_Kd -s 2 2 a.png\nnewmtl b\r\nbump -bm 0.5 b h.png\nnorm n.png\n").unwrap();
+        assert_eq!(maps["a"][0].0, "map_Kd");
+        assert_eq!(maps["a"][0].1.options.s, [2.0, 2.0, 1.0]);
+        assert_eq!((maps["b"][0].1.file.as_str(), maps["b"][0].1.options.bm), ("b h.png", 0.5));
+        assert_eq!(maps["b"][1].0, "norm");
+        let e = check("newmtl a\n\nmap_d -imfchan x a.png\n").unwrap_err();
+        assert_eq!(e.line_number(), Some(3));
+        assert!(e.to_string().contains("-imfchan"), "{e}");
     }
 }

@@ -4,7 +4,8 @@
 //!
 //! All groups and objects of the file become one mesh, each triangle keeping its material.
 //! Polygons are triangulated by englobe ([`super::triangulate`]): `tobj`'s fan would cover the
-//! notches of concave faces.
+//! notches of concave faces. Texture coordinates are flipped to englobe's convention (`v` down
+//! from the top of the image: `v = 1 - vt`), and materials are mapped by [`super::mtl_material`].
 
 use std::cell::RefCell;
 use std::collections::HashMap;
@@ -15,6 +16,8 @@ use englobe::{Vec2, Vec3};
 use super::build::{MeshParts, finish};
 use super::error::{MeshErrorKind, MeshFileError};
 use super::loaded::{LoadedMesh, MAX_MTL_FILE_BYTES, MeshFormat, NO_MATERIAL};
+use super::mtl_map::MapStatement;
+use super::mtl_material::{MtlTextures, to_material};
 use super::read::{guarded, read_limited, utf8_text};
 use super::triangulate::triangulate;
 use super::{mtl, obj_scan};
@@ -24,6 +27,8 @@ use super::{mtl, obj_scan};
 struct Libraries {
     error: Option<MeshFileError>,
     warnings: Vec<String>,
+    /// Each material's texture statements and the folder of its library.
+    maps: HashMap<String, (PathBuf, Vec<(String, MapStatement)>)>,
 }
 
 /// Loads the OBJ file `path` whose content is `bytes`.
@@ -59,11 +64,20 @@ pub(super) fn load(path: &Path, bytes: Vec<u8>) -> Result<LoadedMesh, MeshFileEr
     if let Some(e) = libraries.error {
         return Err(e);
     }
-    warnings.extend(libraries.warnings);
+    warnings.extend(libraries.warnings.iter().cloned());
     let (models, materials) =
         parsed.map_err(|e| MeshFileError::file(path, MeshErrorKind::Parser(format!("tobj: {e}"))))?;
-    let materials: Vec<_> =
-        materials.unwrap_or_default().iter().map(|m| (m.name.clone(), mtl::to_material(m))).collect();
+    let mut textures = MtlTextures::default();
+    let materials: Vec<_> = materials
+        .unwrap_or_default()
+        .iter()
+        .map(|m| {
+            let (dir, maps) =
+                libraries.maps.get(&m.name).map_or((dir.as_path(), &[][..]), |(d, s)| (d.as_path(), s.as_slice()));
+            (m.name.clone(), to_material(m, maps, dir, &mut textures))
+        })
+        .collect();
+    warnings.append(&mut textures.warnings);
     let undefined: Vec<&str> =
         scan.used_materials.iter().filter(|u| !materials.iter().any(|(n, _)| n == *u)).map(String::as_str).collect();
     if !undefined.is_empty() {
@@ -89,7 +103,7 @@ pub(super) fn load(path: &Path, bytes: Vec<u8>) -> Result<LoadedMesh, MeshFileEr
             normals.extend(m.normals.chunks_exact(3).map(|n| Vec3::new(n[0], n[1], n[2])));
         }
         if all_uvs {
-            uvs.extend(m.texcoords.chunks_exact(2).map(|t| Vec2::new(t[0], t[1])));
+            uvs.extend(m.texcoords.chunks_exact(2).map(|t| Vec2::new(t[0], 1.0 - t[1])));
         }
         let material = m.material_id.map_or(NO_MATERIAL, |id| id as u32);
         let before = parts.triangles.len();
@@ -122,7 +136,7 @@ pub(super) fn load(path: &Path, bytes: Vec<u8>) -> Result<LoadedMesh, MeshFileEr
     parts.normals = (all_normals && !normals.is_empty()).then_some(normals);
     parts.uvs = (all_uvs && !uvs.is_empty()).then_some(uvs);
     parts.triangle_materials = Some(ids);
-    finish(path, MeshFormat::Obj, parts, materials, warnings)
+    finish(path, MeshFormat::Obj, parts, (materials, textures.textures), warnings)
 }
 
 /// The text with the given (0-based) lines replaced by comments.
@@ -163,10 +177,12 @@ fn load_library(dir: &Path, name: &Path, state: &RefCell<Libraries>) -> tobj::MT
             continue;
         }
         match read_library(&file) {
-            Ok((mats, names)) => {
+            Ok((mats, names, maps)) => {
                 let offset = materials.len();
                 materials.extend(mats);
                 map.extend(names.into_iter().map(|(n, i)| (n, i + offset)));
+                let folder = file.parent().map(Path::to_path_buf).unwrap_or_default();
+                state.borrow_mut().maps.extend(maps.into_iter().map(|(n, s)| (n, (folder.clone(), s))));
             }
             Err(e) => {
                 let mut s = state.borrow_mut();
@@ -199,11 +215,14 @@ fn split_names(list: &str) -> Vec<String> {
     names
 }
 
-fn read_library(file: &Path) -> Result<(Vec<tobj::Material>, HashMap<String, usize>), MeshFileError> {
+type Library = (Vec<tobj::Material>, HashMap<String, usize>, mtl::MtlMaps);
+
+fn read_library(file: &Path) -> Result<Library, MeshFileError> {
     let text = utf8_text(file, read_limited(file, MAX_MTL_FILE_BYTES)?)?;
-    mtl::scan(file, &text)?;
-    guarded(file, "MTL", || tobj::load_mtl_buf(&mut text.as_bytes()))?
-        .map_err(|e| MeshFileError::file(file, MeshErrorKind::Parser(format!("tobj: {e}"))))
+    let maps = mtl::scan(file, &text)?;
+    let (materials, names) = guarded(file, "MTL", || tobj::load_mtl_buf(&mut text.as_bytes()))?
+        .map_err(|e| MeshFileError::file(file, MeshErrorKind::Parser(format!("tobj: {e}"))))?;
+    Ok((materials, names, maps))
 }
 
 #[cfg(test)]

@@ -4,6 +4,8 @@
 //! (`nx ny nz`), texture coordinates (`u v`, `s t` or `texture_u texture_v`) and the face lists
 //! (`vertex_indices` or `vertex_index`), fan- or ear-triangulated, or the triangle strips of a
 //! `tristrips` element (older scanned-model archives store faces so). Everything else is skipped.
+//! Texture coordinates follow OpenGL's convention in PLY (`v` up from the bottom of the image) and
+//! are flipped to englobe's (`v = 1 - t`), as OBJ's are.
 //!
 //! Before anything is allocated, the counts the header declares are checked against the bytes
 //! the file holds, so `element vertex 4294967295` in a 100-byte file is an error, not an attempt
@@ -22,7 +24,8 @@ pub(super) fn load(path: &Path, bytes: &[u8]) -> Result<LoadedMesh, MeshFileErro
     let header = parse_header(path, bytes)?;
     check_sizes(path, &header, bytes.len() as u64)?;
     let body = read_body(path, &header, bytes)?;
-    let mut parts = MeshParts { positions: body.positions, normals: body.normals, uvs: body.uvs, ..Default::default() };
+    let uvs = body.uvs.map(|uvs| uvs.into_iter().map(|t| englobe::Vec2::new(t.x, 1.0 - t.y)).collect());
+    let mut parts = MeshParts { positions: body.positions, normals: body.normals, uvs, ..Default::default() };
     let mut warnings = Vec::new();
     let mut concave = 0usize;
     let mut at = 0usize;
@@ -38,5 +41,5 @@ pub(super) fn load(path: &Path, bytes: &[u8]) -> Result<LoadedMesh, MeshFileErro
     if concave > 0 {
         warnings.push(format!("{concave} concave polygon(s) triangulated by ear clipping"));
     }
-    finish(path, MeshFormat::Ply, parts, Vec::new(), warnings)
+    finish(path, MeshFormat::Ply, parts, (Vec::new(), Vec::new()), warnings)
 }

@@ -1,8 +1,18 @@
 //! Moving a mesh into the scene: positions by the affine transform, normals by the inverse
 //! transpose of its linear part (so they stay perpendicular to the surface under non-uniform
-//! scales and shears).
+//! scales and shears), tangents by the linear part itself, their handedness flipped by a mirror.
 
 use englobe::{Affine3A, TriangleMesh};
+use glam::Vec4;
+
+/// Tangents (see [`crate::SceneObject::tangents`]) moved by `m`'s linear part.
+pub fn transform_tangents(tangents: &[Vec4], m: &Affine3A) -> Vec<Vec4> {
+    let flip = if m.matrix3.determinant() < 0.0 { -1.0 } else { 1.0 };
+    tangents
+        .iter()
+        .map(|t| (m.matrix3 * t.truncate()).normalize_or_zero().extend(if t.w < 0.0 { -flip } else { flip }))
+        .collect()
+}
 
 /// The mesh with `m` applied to its vertices and normals. Refuses transforms that are singular or
 /// that carry a vertex beyond what `f32` holds.
@@ -52,5 +62,17 @@ mod tests {
         assert!(bake_transform(&mesh, &Affine3A::from_scale(Vec3::ZERO)).is_err());
         let far = Affine3A::from_scale_rotation_translation(Vec3::splat(3e38), glam::Quat::IDENTITY, Vec3::splat(3e38));
         assert!(bake_transform(&mesh, &far).is_err());
+    }
+
+    #[test]
+    fn tangents_follow_and_mirrors_flip_them() {
+        let t = [Vec4::new(1.0, 0.0, 0.0, 1.0), Vec4::new(0.0, 1.0, 0.0, -1.0)];
+        let turn = Affine3A::from_rotation_z(std::f32::consts::FRAC_PI_2);
+        let out = transform_tangents(&t, &turn);
+        assert!((out[0] - Vec4::new(0.0, 1.0, 0.0, 1.0)).length() < 1e-6);
+        assert!((out[1] - Vec4::new(-1.0, 0.0, 0.0, -1.0)).length() < 1e-6);
+        let mirror = Affine3A::from_scale(Vec3::new(-2.0, 1.0, 1.0));
+        let out = transform_tangents(&t, &mirror);
+        assert_eq!(out, [Vec4::new(-1.0, 0.0, 0.0, -1.0), Vec4::new(0.0, 1.0, 0.0, 1.0)]);
     }
 }
