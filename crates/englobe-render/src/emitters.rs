@@ -7,10 +7,11 @@
 //! density of a sampled point is `1 / total area` over all emissive triangles. Light sampling and
 //! the bounces that hit an emitter by chance are combined with the power heuristic of Veach and
 //! Guibas (1995), "Optimally Combining Sampling Techniques for Monte Carlo Rendering".
-//! Emissive spheres, boxes and planes are not sampled; bounces find them, with full weight.
+//! Emissive spheres, boxes and planes are not sampled; bounces find them, with full weight; so
+//! are triangles whose emission comes from a texture.
 
 use englobe::{Object, Shape, Vec3};
-use englobe_scene::Scene;
+use englobe_scene::{Material, Scene};
 
 /// One emissive triangle in world space.
 #[derive(Clone, Copy, Debug)]
@@ -47,7 +48,10 @@ impl Emitters {
     pub fn of(scene: &Scene) -> Self {
         let mut emitters = Emitters::default();
         for object in &scene.objects {
-            let emission = |prim: u32| scene.materials[object.material_of(prim) as usize].emission;
+            let emission = |prim: u32| {
+                let m = &scene.materials[object.material_of(prim) as usize];
+                if Emitters::samples(m) { m.emission } else { Vec3::ZERO }
+            };
             match &object.object {
                 Object::Shape(Shape::Triangle(t)) => emitters.push(t.vertices, emission(0)),
                 Object::Mesh(m) => {
@@ -76,6 +80,13 @@ impl Emitters {
         self.total_area += area;
         self.cumulative.push(self.total_area);
         self.triangles.push(EmissiveTriangle { v0: a, e1: b - a, e2: c - a, emission });
+    }
+
+    /// Whether the triangles of material `m` are sampled when they emit: not when an emission
+    /// texture varies their radiance over the surface (sampling by area with the factor alone
+    /// would be biased), which leaves them to the bounces that hit them.
+    pub fn samples(m: &Material) -> bool {
+        m.textures.emission.is_none()
     }
 
     /// True if there is nothing to sample.

@@ -32,6 +32,7 @@ pub mod shading;
 pub mod stats;
 pub mod supersample;
 pub mod tile;
+pub mod visibility;
 pub mod whitted;
 
 pub use camera::ImageCamera;

@@ -18,16 +18,18 @@
 
 use std::f32::consts::PI;
 
-use englobe::{Counters, Object, Ray, Shape, Vec3, World, WorldHit};
-use englobe_scene::Scene;
+use englobe::{Counters, Object, Ray, Shape, Vec2, Vec3, World, WorldHit};
+use englobe_scene::{MaterialModel, Scene};
 use rand::RngExt;
 use rand_pcg::Pcg32;
 
+use crate::bsdf::{Bsdf, Frame, SampleKind};
 use crate::emitters::{Emitters, power_heuristic};
 use crate::optics::{fresnel_dielectric, reflect, refract};
 use crate::sampling::cosine_hemisphere;
 use crate::shading::{SHADOW_RAY_END, Surface};
 use crate::stats::{RayKind, Tally};
+use crate::visibility::Visibility;
 
 /// Bounces before Russian roulette may end a path.
 const ROULETTE_AFTER: u32 = 3;
@@ -36,45 +38,165 @@ const ROULETTE_AFTER: u32 = 3;
 pub struct PathTracer<'a> {
     scene: &'a Scene,
     world: &'a World,
+    vis: Visibility<'a>,
     emitters: Emitters,
+}
+
+/// Where a path goes from a hit: the next ray, its kind, the factor on the throughput and the
+/// density of its direction when emitters were sampled at the hit too (for their MIS weights).
+struct Scatter {
+    ray: Ray,
+    kind: RayKind,
+    weight: Vec3,
+    pdf: Option<f32>,
 }
 
 impl<'a> PathTracer<'a> {
     /// The integrator. `world` must hold the scene's objects in the scene's order.
     pub fn new(scene: &'a Scene, world: &'a World) -> Self {
-        PathTracer { scene, world, emitters: Emitters::of(scene) }
+        PathTracer { scene, world, vis: Visibility::new(scene, world), emitters: Emitters::of(scene) }
     }
 
     /// True if the hit lies on a triangle, which [`Emitters`] samples when it emits.
-    fn is_sampled_emitter(&self, hit: &WorldHit) -> bool {
-        matches!(
-            self.world.objects()[hit.object as usize],
-            Object::Shape(Shape::Triangle(_)) | Object::Mesh(_) | Object::Instance(_)
-        )
+    fn is_sampled_emitter(&self, hit: &WorldHit, s: &Surface) -> bool {
+        Emitters::samples(s.material)
+            && matches!(
+                self.world.objects()[hit.object as usize],
+                Object::Shape(Shape::Triangle(_)) | Object::Mesh(_) | Object::Instance(_)
+            )
     }
 
-    /// Light from one point sampled on the emissive triangles, reflected by the diffuse lobe of
-    /// `s` (not yet weighted by the lobe's share), with its power-heuristic weight.
-    fn sample_emitters<C: Counters>(&self, s: &Surface, rng: &mut Pcg32, tally: &mut Tally<C>) -> Vec3 {
+    /// Light from one point sampled on the emissive triangles, reflected at `s` by `bsdf` (which
+    /// gives `f * cos` and the density of sampling that direction), with its power-heuristic
+    /// weight.
+    fn sample_emitters<C: Counters>(
+        &self,
+        s: &Surface,
+        rng: &mut Pcg32,
+        tally: &mut Tally<C>,
+        bsdf: impl Fn(Vec3) -> (Vec3, f32),
+    ) -> Vec3 {
         let Some(e) = self.emitters.sample(rng.random(), rng.random(), rng.random()) else {
             return Vec3::ZERO;
         };
         let v = e.point - s.p;
         let dist2 = v.length_squared();
         let wi = v / dist2.sqrt();
-        let (cos_s, cos_l) = (s.ns.dot(wi), -e.normal.dot(wi));
-        if !(cos_s > 0.0 && cos_l > 0.0 && wi.dot(s.n) > 0.0) {
+        let cos_l = -e.normal.dot(wi);
+        if !(cos_l > 0.0 && wi.dot(s.n) > 0.0) {
+            return Vec3::ZERO;
+        }
+        let (f_cos, pdf_bounce) = bsdf(wi);
+        if f_cos == Vec3::ZERO {
             return Vec3::ZERO;
         }
         let origin = s.outside();
         tally.rays[RayKind::Shadow as usize] += 1;
         let shadow = Ray::segment(origin, e.point - origin, 0.0, SHADOW_RAY_END);
-        if self.world.any_hit(&shadow, &mut tally.work[RayKind::Shadow as usize]) {
+        if self.vis.any_hit(&shadow, &mut tally.work[RayKind::Shadow as usize]) {
             return Vec3::ZERO;
         }
         let pdf_light = self.emitters.area_pdf() * dist2 / cos_l;
-        let pdf_bounce = cos_s / PI;
-        s.material.diffuse / PI * e.emission * (cos_s * power_heuristic(pdf_light, pdf_bounce) / pdf_light)
+        f_cos * e.emission * (power_heuristic(pdf_light, pdf_bounce) / pdf_light)
+    }
+
+    /// A microfacet surface (glTF's metallic-roughness model, see [`crate::bsdf`]): light from
+    /// the point and directional lights and from the emitters, added to `radiance`, and where the
+    /// path goes on, drawn from the BSDF.
+    fn scatter_microfacet<C: Counters>(
+        &self,
+        s: &Surface,
+        rng: &mut Pcg32,
+        tally: &mut Tally<C>,
+        throughput: Vec3,
+        radiance: &mut Vec3,
+    ) -> Option<Scatter> {
+        let p = &s.params;
+        let bsdf = Bsdf::metallic_roughness(p.base_color, p.metallic, p.roughness, p.transmission, p.ior);
+        // The frame of a transmitting BSDF must face outward; the others are two-sided.
+        let frame = Frame::from_z(if s.entering { s.ns } else { -s.ns });
+        let wo = frame.to_local(-s.d);
+        if !bsdf.is_delta() {
+            let f_cos = |wi: Vec3| {
+                let l = frame.to_local(wi);
+                (bsdf.eval(wo, l) * l.z.abs(), bsdf.pdf(wo, l))
+            };
+            // Point and directional lights: their intensities are pi times radiant intensities
+            // (see `crate::shading`), so f * cos * pi * radiance.
+            let mut lit = Vec3::ZERO;
+            s.for_each_light(self.scene, &self.vis, tally, |wi, light| lit += f_cos(wi).0 * PI * light);
+            if !self.emitters.is_empty() {
+                lit += self.sample_emitters(s, rng, tally, f_cos);
+            }
+            *radiance += throughput * lit;
+        }
+        let sample = bsdf.sample(wo, rng.random(), Vec2::new(rng.random(), rng.random()))?;
+        let wi = frame.from_local(sample.wi);
+        let through = sample.kind == SampleKind::Transmission;
+        // A direction on the wrong side of the true surface (a bent shading normal): no light
+        // comes from there.
+        if (wi.dot(s.n) > 0.0) == through {
+            return None;
+        }
+        let kind = match (through, sample.delta) {
+            (true, _) => RayKind::Refracted,
+            (false, true) => RayKind::Reflected,
+            (false, false) => RayKind::Bounce,
+        };
+        let origin = if through { s.inside() } else { s.outside() };
+        let pdf = (!sample.delta && !bsdf.is_delta()).then_some(sample.pdf);
+        Some(Scatter { ray: Ray::new(origin, wi), kind, weight: sample.weight, pdf })
+    }
+
+    /// The seed's model (see the module's documentation): direct light through the Whitted
+    /// weights plus the emitters, then one lobe drawn by its weight.
+    fn scatter_classic<C: Counters>(
+        &self,
+        s: &Surface,
+        rng: &mut Pcg32,
+        tally: &mut Tally<C>,
+        throughput: Vec3,
+        radiance: &mut Vec3,
+    ) -> Option<Scatter> {
+        let m = s.material;
+        let base = s.params.base_color;
+        let (kr, kt) = (m.reflectivity, m.transparency);
+        if kr + kt < 1.0 || m.specular != Vec3::ZERO {
+            // Direct light at every hit, weighted as the Whitted integrator weights it, so
+            // that the first bounce of both integrators agrees.
+            let (mut lit, highlight) = s.direct_light(self.scene, &self.vis, tally);
+            if kr + kt < 1.0 && !self.emitters.is_empty() {
+                let lambert = |wi: Vec3| {
+                    let cos = s.ns.dot(wi).max(0.0);
+                    (base / PI * cos, cos / PI)
+                };
+                lit += self.sample_emitters(s, rng, tally, lambert);
+            }
+            *radiance += throughput * (lit * (1.0 - kr - kt) + highlight);
+        }
+        let lobe: f32 = rng.random();
+        if lobe < kr {
+            let ray = Ray::new(s.outside(), reflect(s.d, s.n));
+            return Some(Scatter { ray, kind: RayKind::Reflected, weight: Vec3::ONE, pdf: None });
+        }
+        if lobe < kr + kt {
+            let eta = if s.entering { 1.0 / m.ior } else { m.ior };
+            let refracted = refract(s.d, s.n, eta).and_then(|(t_dir, cos_t)| {
+                let f = fresnel_dielectric(-s.d.dot(s.n), cos_t, eta);
+                (rng.random::<f32>() >= f).then_some(t_dir)
+            });
+            let (ray, kind) = match refracted {
+                Some(t_dir) => (Ray::new(s.inside(), t_dir), RayKind::Refracted),
+                None => (Ray::new(s.outside(), reflect(s.d, s.n)), RayKind::Reflected),
+            };
+            return Some(Scatter { ray, kind, weight: Vec3::ONE, pdf: None });
+        }
+        let dir = cosine_hemisphere(s.ns, rng.random(), rng.random());
+        if dir.dot(s.n) <= 0.0 {
+            return None; // a smooth normal bent below the true surface: no light comes from there
+        }
+        let pdf = Some(dir.dot(s.ns) / PI);
+        Some(Scatter { ray: Ray::new(s.outside(), dir), kind: RayKind::Bounce, weight: base, pdf })
     }
 
     /// One estimate of the radiance along the primary ray `ray`.
@@ -83,65 +205,40 @@ impl<'a> PathTracer<'a> {
         let mut throughput = Vec3::ONE;
         let mut ray = *ray;
         let mut kind = RayKind::Primary;
-        // The density of the last bounce when it was diffuse (emitters were sampled there too).
+        // The density of the last bounce when emitters were sampled there too.
         let mut bounce_pdf: Option<f32> = None;
         for depth in 0..=self.scene.image.max_depth {
             tally.rays[kind as usize] += 1;
-            let Some(hit) = self.world.closest_hit(&ray, &mut tally.work[kind as usize]) else {
+            let Some(hit) = self.vis.closest_hit(&ray, &mut tally.work[kind as usize]) else {
                 radiance += throughput * self.scene.image.background;
                 break;
             };
             let s = Surface::at(self.scene, self.world, &ray, &hit);
-            let m = s.material;
-            // Surfaces emit from their front side only (outward normal, or the winding's normal).
-            if m.emission != Vec3::ZERO && s.entering {
+            // Surfaces emit from their front side only (outward normal, or the winding's normal),
+            // or from both when the material is double-sided.
+            let emission = s.params.emission;
+            if emission != Vec3::ZERO && (s.entering || s.material.double_sided) {
                 let weight = match bounce_pdf {
-                    Some(pdf) if self.is_sampled_emitter(&hit) => {
+                    Some(pdf) if s.entering && self.is_sampled_emitter(&hit, &s) => {
                         let pdf_light = self.emitters.area_pdf() * hit.t * hit.t / (-s.d.dot(s.n)).max(1e-12);
                         power_heuristic(pdf, pdf_light)
                     }
                     _ => 1.0,
                 };
-                radiance += throughput * m.emission * weight;
+                radiance += throughput * emission * weight;
             }
             if depth == self.scene.image.max_depth {
                 break;
             }
-            let (kr, kt) = (m.reflectivity, m.transparency);
-            if kr + kt < 1.0 || m.specular != Vec3::ZERO {
-                // Direct light at every hit, weighted as the Whitted integrator weights it, so
-                // that the first bounce of both integrators agrees.
-                let (mut lit, highlight) = s.direct_light(self.scene, self.world, tally);
-                if kr + kt < 1.0 && !self.emitters.is_empty() {
-                    lit += self.sample_emitters(&s, rng, tally);
+            let next = match s.material.model {
+                MaterialModel::Classic => self.scatter_classic(&s, rng, tally, throughput, &mut radiance),
+                MaterialModel::MetallicRoughness { .. } => {
+                    self.scatter_microfacet(&s, rng, tally, throughput, &mut radiance)
                 }
-                radiance += throughput * (lit * (1.0 - kr - kt) + highlight);
-            }
-            bounce_pdf = None;
-            let lobe: f32 = rng.random();
-            if lobe < kr {
-                ray = Ray::new(s.outside(), reflect(s.d, s.n));
-                kind = RayKind::Reflected;
-            } else if lobe < kr + kt {
-                let eta = if s.entering { 1.0 / m.ior } else { m.ior };
-                let refracted = refract(s.d, s.n, eta).and_then(|(t_dir, cos_t)| {
-                    let f = fresnel_dielectric(-s.d.dot(s.n), cos_t, eta);
-                    (rng.random::<f32>() >= f).then_some(t_dir)
-                });
-                (ray, kind) = match refracted {
-                    Some(t_dir) => (Ray::new(s.inside(), t_dir), RayKind::Refracted),
-                    None => (Ray::new(s.outside(), reflect(s.d, s.n)), RayKind::Reflected),
-                };
-            } else {
-                let dir = cosine_hemisphere(s.ns, rng.random(), rng.random());
-                if dir.dot(s.n) <= 0.0 {
-                    break; // a smooth normal bent below the true surface: no light comes from there
-                }
-                throughput *= m.diffuse;
-                bounce_pdf = Some(dir.dot(s.ns) / PI);
-                ray = Ray::new(s.outside(), dir);
-                kind = RayKind::Bounce;
-            }
+            };
+            let Some(next) = next else { break };
+            throughput *= next.weight;
+            (ray, kind, bounce_pdf) = (next.ray, next.kind, next.pdf);
             if depth >= ROULETTE_AFTER {
                 let survive = throughput.max_element().min(1.0);
                 if !(rng.random::<f32>() < survive) {

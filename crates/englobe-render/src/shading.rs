@@ -7,11 +7,12 @@
 //! response to a light is `diffuse * cos θ * radiance`, with no `1 / π` (the path tracer uses the
 //! same response, which amounts to reading the scene's intensities as `π` times a radiant intensity).
 
-use englobe::{Counters, Ray, Vec3, World, WorldHit};
-use englobe_scene::{Light, Material, Scene};
+use englobe::{Counters, Object, Ray, Vec3, World, WorldHit};
+use englobe_scene::{Light, Material, MaterialModel, Scene, SurfaceParams};
 
 use crate::optics::offset_ray_origin;
 use crate::stats::{RayKind, Tally};
+use crate::visibility::Visibility;
 
 /// Shadow rays toward a point light stop this fraction short of it.
 pub(crate) const SHADOW_RAY_END: f32 = 1.0 - 1e-4;
@@ -30,21 +31,45 @@ pub struct Surface<'a> {
     pub entering: bool,
     /// The material.
     pub material: &'a Material,
+    /// The material's parameters at this point, its textures applied.
+    pub params: SurfaceParams,
 }
 
 impl<'a> Surface<'a> {
-    /// The surface at `hit` of `ray`.
+    /// The surface at `hit` of `ray`: the material's textures read at the hit's texture
+    /// coordinate, the shading normal bent by its normal map (in the frame of the mesh's tangents,
+    /// moved into the world by an instance's transform).
     pub fn at(scene: &'a Scene, world: &World, ray: &Ray, hit: &WorldHit) -> Self {
-        let id = scene.objects[hit.object as usize].material_of(hit.prim);
-        let material = &scene.materials[id as usize];
+        let object = &scene.objects[hit.object as usize];
+        let material = &scene.materials[object.material_of(hit.prim) as usize];
         let p = world.hit_point(ray, hit);
         let d = ray.dir().normalize();
         let geometric = world.geometric_normal(hit, p);
         let entering = d.dot(geometric) < 0.0;
         let n = if entering { geometric } else { -geometric };
-        let shading = world.shading_normal(hit, p);
+        let uv = if material.textures.is_empty() { None } else { object.uv(hit.prim, hit.u, hit.v) };
+        let params = material.evaluate(&scene.textures, uv);
+        let mut shading = world.shading_normal(hit, p);
+        if let (Some(bent), Some(tangent)) = (params.normal_ts, object.tangent(hit.prim, hit.u, hit.v)) {
+            let (t, w) = match &world.objects()[hit.object as usize] {
+                Object::Instance(inst) => {
+                    let m = inst.to_world();
+                    (
+                        m.transform_vector3(tangent.truncate()),
+                        if m.matrix3.determinant() < 0.0 { -tangent.w } else { tangent.w },
+                    )
+                }
+                _ => (tangent.truncate(), tangent.w),
+            };
+            // Gram-Schmidt: the tangent made perpendicular to the interpolated normal.
+            let t = (t - shading * shading.dot(t)).normalize_or_zero();
+            if t != Vec3::ZERO {
+                let b = shading.cross(t) * w;
+                shading = (t * bent.x + b * bent.y + shading * bent.z).normalize_or(shading);
+            }
+        }
         let ns = if shading.dot(n) < 0.0 { -shading } else { shading };
-        Surface { p, d, n, ns, entering, material }
+        Surface { p, d, n, ns, entering, material, params }
     }
 
     /// The origin of rays leaving on the side the ray came from.
@@ -57,13 +82,17 @@ impl<'a> Surface<'a> {
         offset_ray_origin(self.p, -self.n)
     }
 
-    /// The diffuse and highlight light arriving from every light that the point sees, one
-    /// shadow ray per light in front of the surface. Returns `(diffuse, highlight)`, the first
-    /// to be weighted by the surface's diffuse share.
-    pub fn direct_light<C: Counters>(&self, scene: &Scene, world: &World, tally: &mut Tally<C>) -> (Vec3, Vec3) {
-        let m = self.material;
+    /// Calls `f(to_light, radiance)` for every point or directional light in front of the
+    /// surface that the point sees, one shadow ray per light: `to_light` the unit direction to
+    /// the light, `radiance` what arrives in the units of the module's note.
+    pub fn for_each_light<C: Counters>(
+        &self,
+        scene: &Scene,
+        vis: &Visibility,
+        tally: &mut Tally<C>,
+        mut f: impl FnMut(Vec3, Vec3),
+    ) {
         let origin = self.outside();
-        let (mut diffuse, mut highlight) = (Vec3::ZERO, Vec3::ZERO);
         for light in &scene.lights {
             let (shadow_ray, to_light, radiance) = match *light {
                 Light::Point { position, power } => {
@@ -79,15 +108,29 @@ impl<'a> Surface<'a> {
                 continue; // the light is behind the surface
             }
             tally.rays[RayKind::Shadow as usize] += 1;
-            if world.any_hit(&shadow_ray, &mut tally.work[RayKind::Shadow as usize]) {
+            if vis.any_hit(&shadow_ray, &mut tally.work[RayKind::Shadow as usize]) {
                 continue;
             }
-            diffuse += m.diffuse * self.ns.dot(to_light).max(0.0) * radiance;
-            if m.specular != Vec3::ZERO {
-                let half = (to_light - self.d).normalize_or_zero();
-                highlight += m.specular * self.ns.dot(half).max(0.0).powf(m.shininess) * radiance;
-            }
+            f(to_light, radiance);
         }
+    }
+
+    /// The diffuse and highlight light arriving from every light that the point sees, one
+    /// shadow ray per light in front of the surface. Returns `(diffuse, highlight)`, the first
+    /// to be weighted by the surface's diffuse share.
+    pub fn direct_light<C: Counters>(&self, scene: &Scene, vis: &Visibility, tally: &mut Tally<C>) -> (Vec3, Vec3) {
+        let m = &self.params;
+        // The Blinn-Phong highlight belongs to the classic model; a metallic-roughness material
+        // reaches Whitted's integrator as its diffuse base colour.
+        let shiny = m.specular != Vec3::ZERO && self.material.model == MaterialModel::Classic;
+        let (mut diffuse, mut highlight) = (Vec3::ZERO, Vec3::ZERO);
+        self.for_each_light(scene, vis, tally, |to_light, radiance| {
+            diffuse += m.base_color * self.ns.dot(to_light).max(0.0) * radiance;
+            if shiny {
+                let half = (to_light - self.d).normalize_or_zero();
+                highlight += m.specular * self.ns.dot(half).max(0.0).powf(self.material.shininess) * radiance;
+            }
+        });
         (diffuse, highlight)
     }
 }

@@ -14,6 +14,9 @@
 //! ...) along its path; with the scene's `min_contribution`, a ray whose contribution would fall
 //! below it is not cast, so that deep trees are cut where they no longer change the pixel, instead
 //! of at one fixed depth for every path.
+//!
+//! Textures shade it as they shade the path tracer (base colour, highlight colour, emission, normal
+//! maps, cut-outs); a metallic-roughness material reaches it as its diffuse base colour.
 
 use englobe::{Counters, Ray, Vec3, World};
 use englobe_scene::Scene;
@@ -21,17 +24,19 @@ use englobe_scene::Scene;
 use crate::optics::{fresnel_dielectric, reflect, refract};
 use crate::shading::Surface;
 use crate::stats::{RayKind, Tally};
+use crate::visibility::Visibility;
 
 /// The Whitted integrator over a scene and its world (built from the scene's objects, in order).
 pub struct Whitted<'a> {
     scene: &'a Scene,
     world: &'a World,
+    vis: Visibility<'a>,
 }
 
 impl<'a> Whitted<'a> {
     /// The integrator. `world` must hold the scene's objects in the scene's order.
     pub fn new(scene: &'a Scene, world: &'a World) -> Self {
-        Whitted { scene, world }
+        Whitted { scene, world, vis: Visibility::new(scene, world) }
     }
 
     /// The colour seen along a primary `ray`.
@@ -43,15 +48,15 @@ impl<'a> Whitted<'a> {
     /// whose colour reaches the pixel multiplied by `weight`.
     fn trace<C: Counters>(&self, ray: &Ray, kind: RayKind, depth: u32, weight: f32, tally: &mut Tally<C>) -> Vec3 {
         tally.rays[kind as usize] += 1;
-        let Some(hit) = self.world.closest_hit(ray, &mut tally.work[kind as usize]) else {
+        let Some(hit) = self.vis.closest_hit(ray, &mut tally.work[kind as usize]) else {
             return self.scene.image.background;
         };
         let s = Surface::at(self.scene, self.world, ray, &hit);
         let m = s.material;
         let (kr, kt) = (m.reflectivity, m.transparency);
-        let (lit, highlight) = s.direct_light(self.scene, self.world, tally);
-        let diffuse = self.scene.image.ambient * m.diffuse + lit;
-        let mut color = m.emission + diffuse * (1.0 - kr - kt) + highlight;
+        let (lit, highlight) = s.direct_light(self.scene, &self.vis, tally);
+        let diffuse = self.scene.image.ambient * s.params.base_color * s.params.occlusion + lit;
+        let mut color = s.params.emission + diffuse * (1.0 - kr - kt) + highlight;
 
         if depth >= self.scene.image.max_depth {
             return color;
