@@ -5,6 +5,7 @@
 //! glTF 2.0). A bad file is refused with an error that names the file, the line (or byte) and
 //! says what was expected; nothing here panics on user input.
 
+pub mod environment;
 pub mod error;
 pub mod format;
 pub mod framing;
@@ -13,14 +14,16 @@ pub mod model;
 pub mod numbers;
 pub mod overrides;
 pub mod parse;
+mod parse_environment;
 mod parse_mesh;
 pub mod random_triangles;
 pub mod shared_data;
 
+pub use environment::{Environment, EnvironmentMap, Sky};
 pub use error::{Located, SceneError};
 pub use model::{
-    Camera, ImageSettings, IntegratorKind, Light, MAX_DEPTH, MAX_PIXELS, MAX_SAMPLES, Material, MaterialId, Projection,
-    Scene, SceneObject,
+    Camera, ImageSettings, IntegratorKind, Light, MAX_DEPTH, MAX_PIXELS, MAX_SAMPLES, Material, MaterialId,
+    OutputSettings, Projection, Scene, SceneObject, ToneMap,
 };
 pub use overrides::Override;
 pub use parse::{DEFAULT_MATERIAL, load_scene, load_scene_with, parse_scene, parse_scene_with};
