@@ -312,7 +312,7 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("half.exr");
         let mut film = Film::new(5, 3);
-        let values = [0.0f32, 1.0, 0.1, 3.14159, 1234.567, 6.1e-5, 1e-3, 65504.0, 1e9];
+        let values = [0.0f32, 1.0, 0.1, 2.71, 1234.567, 6.1e-5, 1e-3, 65504.0, 1e9];
         for (i, v) in values.iter().enumerate() {
             film.set(i as u32 % 5, i as u32 / 5, englobe::Vec3::new(*v, v * 0.5, 2.0 * v));
         }
