@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Coverage-guided fuzzing of the scene parser, each mesh loader and the tile reader with cargo fuzz
+# Coverage-guided fuzzing of the scene parser, each mesh loader, the environment map decoder and the
+# tile reader with cargo fuzz
 # (libFuzzer).
 #
 #   scripts/fuzz.sh [SECONDS_PER_TARGET] [TARGET...]
@@ -14,7 +15,7 @@ cd "$(dirname "$0")/.."
 seconds=${1:-60}
 shift || true
 targets=("$@")
-[ ${#targets[@]} -gt 0 ] || targets=(scene_toml mesh_obj mesh_ply mesh_gltf tile_exr mtl_text texture_image)
+[ ${#targets[@]} -gt 0 ] || targets=(scene_toml mesh_obj mesh_ply mesh_gltf environment_map tile_exr mtl_text texture_image)
 shared=${ENGLOBE_SHARED:-../shared}
 
 seed() {
@@ -27,6 +28,12 @@ seed() {
         mesh_gltf) find "$shared/scenes/meshes" \( -name '*.gltf' -o -name '*.glb' \) -size -2M -exec cp {} "$dir/" \; ;;
         mtl_text) find "$shared/scenes/meshes" -name '*.mtl' -size -200k -exec cp {} "$dir/" \; ;;
         texture_image) find "$shared/scenes/meshes" \( -name '*.png' -o -name '*.jpg' \) -size -200k -exec cp {} "$dir/" \; ;;
+        environment_map)
+            # The shared maps are large; small ones in both formats seed the corpus instead.
+            cargo run -q -- render --width 16 --height 8 --spp 1 -o "$dir/small.exr" -q
+            cargo run -q -- render --width 16 --height 8 --spp 1 --half -o "$dir/half.exr" -q
+            printf '#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 1 +X 2\n\x80\x40\x20\x81\0\0\0\0' > "$dir/tiny.hdr"
+            ;;
         tile_exr)
             for t in 0/1 1/3; do
                 cargo run -q -- render --width 16 --height 9 --spp 1 --tile "$t" -o "$dir/tile-${t%/*}.exr" -q

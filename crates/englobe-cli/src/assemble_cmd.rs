@@ -6,9 +6,12 @@ use std::process::ExitCode;
 
 use anyhow::Context;
 use clap::Args;
-use englobe_render::tile::assemble::{Tile, assemble, missing_tiles};
+use englobe_render::tile::assemble::{Tile, assemble, missing_tiles, output_settings};
 use englobe_render::tile::file::read_tile;
-use englobe_render::write_image;
+use englobe_render::write_image_with;
+use englobe_scene::OutputSettings;
+
+use crate::image_options::OutputOptions;
 
 #[derive(Args)]
 pub struct AssembleArgs {
@@ -26,6 +29,8 @@ pub struct AssembleArgs {
     /// folder list every tile.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
     count: Option<u32>,
+    #[command(flatten)]
+    output_options: OutputOptions,
     /// No summary line.
     #[arg(short, long)]
     quiet: bool,
@@ -56,7 +61,15 @@ pub fn run(args: AssembleArgs) -> anyhow::Result<ExitCode> {
     let output = args.output.expect("clap requires --output without --missing");
     englobe_render::OutputFormat::from_path(&output)?;
     let film = assemble(&tiles)?;
-    write_image(&film, &output)?;
+    // The tiles' own output settings unless the command line says otherwise.
+    let settings = match output_settings(&tiles) {
+        Ok(recorded) => args.output_options.apply(recorded),
+        Err(_) if args.output_options.exposure.is_some() && args.output_options.tonemap.is_some() => {
+            args.output_options.apply(OutputSettings::default())
+        }
+        Err(why) => anyhow::bail!("{why}; choose with --exposure and --tonemap"),
+    };
+    write_image_with(&film, &output, &settings)?;
     if !args.quiet {
         println!("wrote {} ({}x{} from {} tiles)", output.display(), film.width(), film.height(), tiles.len());
     }

@@ -16,7 +16,7 @@ use anyhow::{Context, bail};
 use clap::{Args, Subcommand};
 use englobe_render::tile::assemble::{Tile, assemble};
 use englobe_render::tile::file::{VERSION, read_tile};
-use englobe_render::{TileSpec, write_image};
+use englobe_render::{TileSpec, write_image_with};
 
 use crate::image_options::{Balance, ImageOptions, render_digest};
 use crate::render_cmd::read_scene;
@@ -238,7 +238,7 @@ fn run_slurm(args: SlurmArgs) -> anyhow::Result<ExitCode> {
         bail!(message);
     }
     let film = assemble(&done)?;
-    write_image(&film, &args.output)?;
+    write_image_with(&film, &args.output, &scene.image.output)?;
     say(format!("wrote {} ({width}x{height} from {} tiles in {})", args.output.display(), plan.count, dir.display()));
     Ok(ExitCode::SUCCESS)
 }

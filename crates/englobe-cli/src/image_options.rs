@@ -7,7 +7,7 @@
 
 use clap::{Args, ValueEnum};
 use englobe::AccelKind;
-use englobe_scene::{ImageSettings, IntegratorKind, Override, Scene};
+use englobe_scene::{ImageSettings, IntegratorKind, OutputSettings, Override, Scene, ToneMap};
 
 /// Overrides of the scene's image settings, and the structure to trace with.
 #[derive(Args, Clone, Debug)]
@@ -48,6 +48,51 @@ pub struct ImageOptions {
     /// overrides the scene's `integrator`.
     #[arg(long, value_parser = parse_integrator)]
     pub integrator: Option<IntegratorKind>,
+    #[command(flatten)]
+    pub output: OutputOptions,
+}
+
+/// How the image is written, shared by `render`, `farm` and `assemble`: none of it changes a
+/// linear pixel, so tiles of one render may be assembled with other values.
+#[derive(Args, Clone, Debug, Default)]
+pub struct OutputOptions {
+    /// Exposure in stops for PNG output: values are multiplied by 2^EV before the tone map
+    /// (overrides the scene's `exposure`; EXR keeps the linear values).
+    #[arg(long, value_name = "EV", value_parser = parse_exposure, allow_hyphen_values = true)]
+    pub exposure: Option<f32>,
+    /// Tone map for PNG output: none (values clipped) or filmic (an ACES-like curve); overrides
+    /// the scene's `tonemap`.
+    #[arg(long, value_parser = parse_tonemap)]
+    pub tonemap: Option<ToneMap>,
+    /// Write OpenEXR output in 16-bit half floats (the same as `[image] exr_half = true`).
+    #[arg(long)]
+    pub half: bool,
+}
+
+impl OutputOptions {
+    /// `settings` with these options' overrides.
+    pub fn apply(&self, settings: OutputSettings) -> OutputSettings {
+        OutputSettings {
+            exposure: self.exposure.unwrap_or(settings.exposure),
+            tonemap: self.tonemap.unwrap_or(settings.tonemap),
+            exr_half: self.half || settings.exr_half,
+        }
+    }
+
+    /// The same options as command-line arguments.
+    pub fn to_args(&self) -> Vec<String> {
+        let mut args = Vec::new();
+        if let Some(e) = self.exposure {
+            args.extend(["--exposure".to_owned(), e.to_string()]);
+        }
+        if let Some(t) = self.tonemap {
+            args.extend(["--tonemap".to_owned(), t.name().to_owned()]);
+        }
+        if self.half {
+            args.push("--half".to_owned());
+        }
+        args
+    }
 }
 
 impl ImageOptions {
@@ -58,6 +103,7 @@ impl ImageOptions {
         (image.width, image.height) = image_size(image, self.width, self.height, self.scale);
         image.samples = self.spp.unwrap_or(image.samples);
         image.integrator = self.integrator.unwrap_or(image.integrator);
+        image.output = self.output.apply(image.output);
         ImageSettings::check_limits(image.width, image.height, image.samples, image.max_depth)
             .map_err(anyhow::Error::msg)
     }
@@ -94,6 +140,7 @@ impl ImageOptions {
         push("--scale", self.scale.map(|v| v.to_string()));
         push("--spp", self.spp.map(|v| v.to_string()));
         push("--integrator", self.integrator.map(|i| i.name().to_owned()));
+        args.extend(self.output.to_args());
         args
     }
 }
@@ -157,6 +204,22 @@ pub fn parse_scale(s: &str) -> Result<f64, String> {
     match s.parse::<f64>() {
         Ok(x) if x > 0.0 && x <= 64.0 => Ok(x),
         _ => Err(format!("`{s}`: expected a factor greater than 0 and at most 64, such as 0.25")),
+    }
+}
+
+fn parse_exposure(s: &str) -> Result<f32, String> {
+    let most = englobe_scene::model::MAX_EXPOSURE;
+    match s.parse::<f32>() {
+        Ok(x) if x.abs() <= most => Ok(x),
+        _ => Err(format!("`{s}`: expected stops from -{most} to {most}, such as 1.5 or -2")),
+    }
+}
+
+fn parse_tonemap(s: &str) -> Result<ToneMap, String> {
+    match s {
+        "none" => Ok(ToneMap::None),
+        "filmic" => Ok(ToneMap::Filmic),
+        _ => Err(format!("unknown tone map `{s}`; expected none or filmic")),
     }
 }
 

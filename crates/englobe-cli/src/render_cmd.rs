@@ -11,7 +11,7 @@ use clap::{Args, ValueEnum};
 use englobe_lab::memory::peak_rss_bytes;
 use englobe_lab::report::{StatsReport, stats_table, write_json};
 use englobe_render::tile::file::{TileHeader, VERSION, write_tile};
-use englobe_render::{HeatmapScale, PixelWindow, Renderer, TileSpec, build_world, write_cost_image, write_image};
+use englobe_render::{HeatmapScale, PixelWindow, Renderer, TileSpec, build_world, write_cost_image, write_image_with};
 use englobe_scene::framing::{framing_scene, turntable_position};
 use englobe_scene::mesh::MeshFormat;
 use englobe_scene::{Override, Scene, load_scene_with, parse_scene_with};
@@ -310,6 +310,7 @@ fn render(args: &RenderArgs, interrupted: &'static std::sync::atomic::AtomicBool
             scene_digest: render_digest(&scene, accel, args.balance),
             version: VERSION.to_owned(),
             tile,
+            output: scene.image.output,
         };
         write_tile(&output, &header, &out.film)?;
     }
@@ -324,7 +325,7 @@ fn render(args: &RenderArgs, interrupted: &'static std::sync::atomic::AtomicBool
             Some(write_cost_image(cost, &output, scale)?)
         }
         None => {
-            write_image(&out.film, &output)?;
+            write_image_with(&out.film, &output, &scene.image.output)?;
             None
         }
     };

@@ -291,3 +291,46 @@ fn farm_passes_scene_overrides_and_the_scale_to_its_tasks() {
     assert_eq!(out, std::fs::read(d.join("one.png")).unwrap(), "the tasks rendered with the overrides");
     assert_ne!(out, std::fs::read(d.join("plain.png")).unwrap());
 }
+
+#[test]
+fn exposure_and_tone_map_apply_at_assembly_and_the_clamp_enters_the_digest() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let look = ["--exposure", "1.5", "--tonemap", "filmic"];
+    render(d, &[&look[..], &["-o", "one.png"]].concat());
+    render(d, &["-o", "plain.png"]);
+    assert_ne!(std::fs::read(d.join("one.png")).unwrap(), std::fs::read(d.join("plain.png")).unwrap());
+    // Tiles rendered with the look record it, and assembly applies it.
+    let t: Vec<String> = (0..3)
+        .map(|k| {
+            let name = format!("look{k}.exr");
+            render(d, &[&look[..], &["--tile", &format!("{k}/3"), "-o", &name]].concat());
+            name
+        })
+        .collect();
+    ok(assemble(d, &t, "assembled.png"));
+    assert_eq!(std::fs::read(d.join("assembled.png")).unwrap(), std::fs::read(d.join("one.png")).unwrap());
+    // The look changes no linear pixel: tiles rendered without it are of the same render, and the
+    // command line chooses how to write them.
+    let plain = tiles(d, 3);
+    let mut mixed = vec![t[0].clone(), plain[1].clone(), plain[2].clone()];
+    assert!(failure(assemble(d, &mixed, "x.png")).contains("different output settings"));
+    let mut args = vec!["assemble", "-o", "chosen.png", "--exposure", "1.5", "--tonemap", "filmic"];
+    args.extend(mixed.iter().map(String::as_str));
+    ok(englobe(d, &args));
+    assert_eq!(std::fs::read(d.join("chosen.png")).unwrap(), std::fs::read(d.join("one.png")).unwrap());
+    // A clamp changes pixels: its tiles are another render's.
+    render(d, &["-D", "image.clamp=0.5", "--tile", "0/3", "-o", "clamped.exr"]);
+    mixed[0] = "clamped.exr".into();
+    assert!(failure(assemble(d, &mixed, "x.png")).contains("different renders"));
+    // Half floats: a smaller EXR of the same image, within half precision.
+    render(d, &["--half", "-o", "half.exr"]);
+    render(d, &["-o", "full.exr"]);
+    let (half, full) =
+        (image::open(d.join("half.exr")).unwrap().to_rgb32f(), image::open(d.join("full.exr")).unwrap().to_rgb32f());
+    for (h, f) in half.pixels().zip(full.pixels()) {
+        for (a, b) in h.0.into_iter().zip(f.0) {
+            assert!((a - b).abs() <= b.abs() * 2f32.powi(-11) + 1e-7, "{a} against {b}");
+        }
+    }
+}

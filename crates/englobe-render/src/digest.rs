@@ -11,7 +11,7 @@ use std::collections::HashMap;
 use std::sync::Arc;
 
 use englobe::{Object, TriangleMesh};
-use englobe_scene::Scene;
+use englobe_scene::{Environment, ImageSettings, Scene, Sky};
 
 /// The digest of `scene` rendered with `options` (anything else that changes the pixels, such as
 /// the acceleration structure's name and what the image shows), as 64 hexadecimal digits.
@@ -24,13 +24,27 @@ pub fn scene_digest(scene: &Scene, options: &str) -> String {
         h.update(value.as_bytes());
     };
     text("options", options.to_owned());
-    text("image", format!("{:?}", scene.image));
+    // How the image is written (exposure, tone map, half floats) changes no linear pixel: tiles of
+    // one render written differently still assemble.
+    let image = ImageSettings { output: Default::default(), ..scene.image.clone() };
+    text("image", format!("{image:?}"));
     text("camera", format!("{:?}", scene.camera));
     text("lights", format!("{:?}", scene.lights));
     text("materials", format!("{:?}", scene.materials));
     text("material names", format!("{:?}", scene.material_names));
     // A texture's `Debug` names its source and sampler and carries its texels' hash.
     text("textures", format!("{:?}", scene.textures));
+    // The map's Debug text names only its file: its pixels are hashed by their bits.
+    text("environment", format!("{:?}", scene.environment));
+    if let Some(Environment { sky: Sky::Map(map), .. }) = &scene.environment {
+        h.update(&map.width.to_le_bytes());
+        h.update(&map.height.to_le_bytes());
+        for p in &map.pixels {
+            for c in p.to_array() {
+                h.update(&c.to_bits().to_le_bytes());
+            }
+        }
+    }
     let mut meshes: HashMap<*const TriangleMesh, [u8; 32]> = HashMap::new();
     let mut mesh_digest =
         |mesh: &Arc<TriangleMesh>| *meshes.entry(Arc::as_ptr(mesh)).or_insert_with(|| hash_mesh(mesh));
@@ -120,6 +134,14 @@ mod tests {
         s.objects.push(SceneObject::new(Sphere::new(Vec3::ZERO, 1.0).into(), 0));
         assert_ne!(base, scene_digest(&s, "accel=bvh-wide"));
         let mut s = scene();
+        s.image.clamp = Some(10.0);
+        assert_ne!(base, scene_digest(&s, "accel=bvh-wide"), "the clamp changes pixels");
+        let mut s = scene();
+        s.image.output.exposure = 2.0;
+        s.image.output.tonemap = englobe_scene::ToneMap::Filmic;
+        s.image.output.exr_half = true;
+        assert_eq!(base, scene_digest(&s, "accel=bvh-wide"), "how the image is written changes no pixel");
+        let mut s = scene();
         s.warnings.push("a warning changes nothing in the picture".into());
         assert_eq!(base, scene_digest(&s, "accel=bvh-wide"));
     }
@@ -134,5 +156,29 @@ mod tests {
         };
         assert_eq!(mesh(0.0), mesh(0.0));
         assert_ne!(mesh(0.0), mesh(-0.0));
+    }
+}
+
+#[cfg(test)]
+mod environment_tests {
+    use std::sync::Arc;
+
+    use englobe::Vec3;
+    use englobe_scene::EnvironmentMap;
+
+    use super::*;
+
+    #[test]
+    fn one_pixel_of_the_environment_map_changes_the_digest() {
+        let with = |value: f32| {
+            let mut s = englobe_scene::parse_scene(crate::DEFAULT_SCENE, "default.toml".as_ref()).unwrap();
+            let mut pixels = vec![Vec3::ONE; 8];
+            pixels[5].y = value;
+            let map = EnvironmentMap { path: "same-name.exr".into(), width: 4, height: 2, pixels };
+            s.environment = Some(Environment { sky: Sky::Map(Arc::new(map)), intensity: 1.0, rotation_degrees: 0.0 });
+            scene_digest(&s, "")
+        };
+        assert_eq!(with(1.0), with(1.0));
+        assert_ne!(with(1.0), with(f32::from_bits(1.0f32.to_bits() + 1)));
     }
 }

@@ -1,6 +1,8 @@
-//! The film: linear RGB radiance per pixel, and its conversion to 8-bit sRGB for display.
+//! The film: linear RGB radiance per pixel, and its conversion to 8-bit sRGB for display (after
+//! the exposure and tone map of [`crate::tonemap`]).
 
 use englobe::Vec3;
+use englobe_scene::OutputSettings;
 
 /// A `width` x `height` grid of linear RGB values, row by row from the top.
 #[derive(Clone, Debug, PartialEq)]
@@ -44,6 +46,17 @@ impl Film {
     /// 8-bit sRGB bytes, three per pixel: values are clamped to `0..=1` and gamma-encoded.
     pub fn to_srgb8(&self) -> Vec<u8> {
         self.pixels.iter().flat_map(|p| [p.x, p.y, p.z]).map(encode_srgb8).collect()
+    }
+
+    /// 8-bit sRGB bytes for display, three per pixel: each value exposed and tone mapped as
+    /// `settings` say (see [`crate::tonemap`]), then clamped and gamma-encoded. With the default
+    /// settings, the bytes of [`Film::to_srgb8`].
+    pub fn to_display_srgb8(&self, settings: &OutputSettings) -> Vec<u8> {
+        self.pixels
+            .iter()
+            .flat_map(|p| [p.x, p.y, p.z])
+            .map(|v| encode_srgb8(crate::tonemap::display(v, settings)))
+            .collect()
     }
 
     /// Linear `f32` values, three per pixel (for HDR output).

@@ -8,7 +8,8 @@
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
-use exr::prelude::{Blocks, Compression, Encoding, Image, LineOrder, SpecificChannels, Vec2, WritableImage};
+use englobe_scene::OutputSettings;
+use exr::prelude::{Blocks, Compression, Encoding, Image, LineOrder, SpecificChannels, Vec2, WritableImage, f16};
 use image::{ImageFormat, RgbImage};
 
 use crate::film::Film;
@@ -71,15 +72,27 @@ impl OutputFormat {
 pub const EXR_ENCODING: Encoding =
     Encoding { compression: Compression::ZIP16, blocks: Blocks::ScanLines, line_order: LineOrder::Increasing };
 
-/// Writes the film to `path` (format from the extension), atomically.
+/// Writes the film to `path` (format from the extension), atomically, with the default output
+/// settings: PNG values clipped, EXR in 32-bit floats.
 pub fn write_image(film: &Film, path: &Path) -> Result<(), OutputError> {
+    write_image_with(film, path, &OutputSettings::default())
+}
+
+/// Writes the film to `path` (format from the extension), atomically: a PNG with the exposure and
+/// tone map of `settings` (see [`crate::tonemap`]), an EXR with the linear values themselves, in
+/// half floats if `settings` ask.
+pub fn write_image_with(film: &Film, path: &Path, settings: &OutputSettings) -> Result<(), OutputError> {
     let format = OutputFormat::from_path(path)?;
     write_atomically(path, |w| {
         let (wd, ht) = (film.width(), film.height());
         let result = match format {
-            OutputFormat::Png => RgbImage::from_raw(wd, ht, film.to_srgb8())
+            OutputFormat::Png => RgbImage::from_raw(wd, ht, film.to_display_srgb8(settings))
                 .expect("the film holds exactly width * height pixels")
                 .write_to(w, ImageFormat::Png),
+            OutputFormat::Exr if settings.exr_half => {
+                let pixels = film.pixels();
+                return write_exr_rgb_half(w, path, wd, ht, |i| pixels[i].to_array());
+            }
             OutputFormat::Exr => {
                 let pixels = film.pixels();
                 return write_exr_rgb(w, path, wd, ht, |i| pixels[i].to_array());
@@ -102,6 +115,29 @@ pub fn write_exr_rgb(
     let channels = SpecificChannels::rgb(|p: Vec2<usize>| {
         let [r, g, b] = pixel(p.y() * width + p.x());
         (r, g, b)
+    });
+    Image::from_encoded_channels((width, height as usize), EXR_ENCODING, channels)
+        .write()
+        .to_buffered(w)
+        .map_err(|error| OutputError::EncodeExr { path: path.to_owned(), error })
+}
+
+/// Encodes a `width` x `height` RGB image as OpenEXR in 16-bit half floats with [`EXR_ENCODING`]
+/// (lossless for the halves themselves); `pixel(i)` is the `i`-th pixel, row by row. Values beyond
+/// the largest half (65504) are written as it rather than as infinity.
+pub fn write_exr_rgb_half(
+    w: impl std::io::Write + std::io::Seek,
+    path: &Path,
+    width: u32,
+    height: u32,
+    pixel: impl Sync + Fn(usize) -> [f32; 3],
+) -> Result<(), OutputError> {
+    let width = width as usize;
+    let half =
+        |v: f32| if v.is_nan() { f16::NAN } else { f16::from_f32(v.clamp(-f16::MAX.to_f32(), f16::MAX.to_f32())) };
+    let channels = SpecificChannels::rgb(|p: Vec2<usize>| {
+        let [r, g, b] = pixel(p.y() * width + p.x());
+        (half(r), half(g), half(b))
     });
     Image::from_encoded_channels((width, height as usize), EXR_ENCODING, channels)
         .write()
@@ -268,6 +304,51 @@ mod tests {
         // Blocks compressed on several threads land in increasing order, not as they finish.
         let meta = exr::meta::MetaData::read_from_file(dir.path().join("0.exr"), false).unwrap();
         assert_eq!(meta.headers[0].line_order, LineOrder::Increasing);
+    }
+
+    #[test]
+    fn half_exr_round_trips_within_half_precision() {
+        use exr::meta::attribute::SampleType;
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("half.exr");
+        let mut film = Film::new(5, 3);
+        let values = [0.0f32, 1.0, 0.1, 2.71, 1234.567, 6.1e-5, 1e-3, 65504.0, 1e9];
+        for (i, v) in values.iter().enumerate() {
+            film.set(i as u32 % 5, i as u32 / 5, englobe::Vec3::new(*v, v * 0.5, 2.0 * v));
+        }
+        let half = OutputSettings { exr_half: true, ..OutputSettings::default() };
+        write_image_with(&film, &path, &half).unwrap();
+        let meta = exr::meta::MetaData::read_from_file(&path, false).unwrap();
+        assert!(meta.headers[0].channels.list.iter().all(|c| c.sample_type == SampleType::F16));
+        assert_eq!(meta.headers[0].compression, Compression::ZIP16);
+        let img = image::open(&path).unwrap().to_rgb32f();
+        for (i, v) in values.iter().enumerate() {
+            let got = img.get_pixel(i as u32 % 5, i as u32 / 5).0;
+            for (g, want) in got.into_iter().zip([*v, v * 0.5, 2.0 * v]) {
+                // Half floats keep 11 significant bits: a relative error of at most 2^-11 (and
+                // the largest half, 65504, for anything beyond it).
+                let want = want.min(65504.0);
+                assert!((g - want).abs() <= want * 2f32.powi(-11) + 1e-7, "{want} read back as {g}");
+            }
+        }
+        let full = dir.path().join("full.exr");
+        write_image_with(&film, &full, &OutputSettings::default()).unwrap();
+        assert!(std::fs::metadata(&path).unwrap().len() < std::fs::metadata(&full).unwrap().len());
+    }
+
+    #[test]
+    fn exposure_and_tone_map_change_png_values_and_never_exr_ones() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut film = Film::new(2, 1);
+        film.set(0, 0, englobe::Vec3::new(0.1, 0.2, 4.0));
+        let bright = OutputSettings { exposure: 1.0, tonemap: englobe_scene::ToneMap::Filmic, exr_half: false };
+        let (png, exr) = (dir.path().join("a.png"), dir.path().join("a.exr"));
+        write_image_with(&film, &png, &bright).unwrap();
+        write_image_with(&film, &exr, &bright).unwrap();
+        let got = image::open(&png).unwrap().to_rgb8().get_pixel(0, 0).0;
+        let expected = [0.2f32, 0.4, 8.0].map(|v| crate::film::encode_srgb8(crate::tonemap::filmic(v)));
+        assert_eq!(got, expected);
+        assert_eq!(image::open(&exr).unwrap().to_rgb32f().get_pixel(0, 0).0, [0.1, 0.2, 4.0]);
     }
 
     #[test]

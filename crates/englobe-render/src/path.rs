@@ -9,8 +9,9 @@
 //! sampled explicitly at every hit (next-event estimation, one shadow ray per light, weighted
 //! exactly as the Whitted integrator weights them; see [`crate::shading`]). Emissive triangles
 //! are sampled too, one point per diffuse hit, and combined with the bounces that hit them by
-//! multiple importance sampling (see [`crate::emitters`]); other emissive shapes and the
-//! background are found by the bounces alone. Surfaces emit from their front side only (the side
+//! multiple importance sampling (see [`crate::emitters`]); so are the environment and emissive
+//! spheres (see [`crate::light_sampling`]); other emissive shapes, and the background of a scene
+//! without an environment, are found by the bounces alone. Surfaces emit from their front side only (the side
 //! their outward normal, or a triangle's winding, points to), as physical lamps do. The scene's
 //! `ambient` term, a stand-in for the
 //! indirect light this integrator computes, is not used. Paths end at the scene's maximum depth or,
@@ -25,6 +26,7 @@ use rand_pcg::Pcg32;
 
 use crate::bsdf::{Bsdf, Frame, SampleKind};
 use crate::emitters::{Emitters, power_heuristic};
+use crate::light_sampling::SampledLights;
 use crate::optics::{fresnel_dielectric, reflect, refract};
 use crate::sampling::cosine_hemisphere;
 use crate::shading::{SHADOW_RAY_END, Surface};
@@ -40,6 +42,7 @@ pub struct PathTracer<'a> {
     world: &'a World,
     vis: Visibility<'a>,
     emitters: Emitters,
+    lights: SampledLights,
 }
 
 /// Where a path goes from a hit: the next ray, its kind, the factor on the throughput and the
@@ -54,7 +57,13 @@ struct Scatter {
 impl<'a> PathTracer<'a> {
     /// The integrator. `world` must hold the scene's objects in the scene's order.
     pub fn new(scene: &'a Scene, world: &'a World) -> Self {
-        PathTracer { scene, world, vis: Visibility::new(scene, world), emitters: Emitters::of(scene) }
+        PathTracer {
+            scene,
+            world,
+            vis: Visibility::new(scene, world),
+            emitters: Emitters::of(scene),
+            lights: SampledLights::of(scene),
+        }
     }
 
     /// True if the hit lies on a triangle, which [`Emitters`] samples when it emits.
@@ -128,6 +137,7 @@ impl<'a> PathTracer<'a> {
             if !self.emitters.is_empty() {
                 lit += self.sample_emitters(s, rng, tally, f_cos);
             }
+            lit += self.lights.sample(s, &self.vis, rng, tally, f_cos);
             *radiance += throughput * lit;
         }
         let sample = bsdf.sample(wo, rng.random(), Vec2::new(rng.random(), rng.random()))?;
@@ -172,6 +182,13 @@ impl<'a> PathTracer<'a> {
                 };
                 lit += self.sample_emitters(s, rng, tally, lambert);
             }
+            if kr + kt < 1.0 {
+                let lambert = |wi: Vec3| {
+                    let cos = s.ns.dot(wi).max(0.0);
+                    (base / PI * cos, cos / PI)
+                };
+                lit += self.lights.sample(s, &self.vis, rng, tally, lambert);
+            }
             *radiance += throughput * (lit * (1.0 - kr - kt) + highlight);
         }
         let lobe: f32 = rng.random();
@@ -210,7 +227,7 @@ impl<'a> PathTracer<'a> {
         for depth in 0..=self.scene.image.max_depth {
             tally.rays[kind as usize] += 1;
             let Some(hit) = self.vis.closest_hit(&ray, &mut tally.work[kind as usize]) else {
-                radiance += throughput * self.scene.image.background;
+                radiance += throughput * self.lights.escaped(ray.dir(), bounce_pdf, self.scene.image.background);
                 break;
             };
             let s = Surface::at(self.scene, self.world, &ray, &hit);
@@ -223,6 +240,7 @@ impl<'a> PathTracer<'a> {
                         let pdf_light = self.emitters.area_pdf() * hit.t * hit.t / (-s.d.dot(s.n)).max(1e-12);
                         power_heuristic(pdf, pdf_light)
                     }
+                    Some(pdf) => self.lights.emission_weight(hit.object, ray.origin(), pdf).unwrap_or(1.0),
                     _ => 1.0,
                 };
                 radiance += throughput * emission * weight;

@@ -338,9 +338,13 @@ impl<'a> Renderer<'a> {
         } else {
             camera.ray(x as f32 + dx, y as f32 + dy)
         };
-        match integrator {
+        let radiance = match integrator {
             Integrator::Whitted(w) => w.radiance(&ray, tally),
             Integrator::Path(p) => p.radiance(&ray, rng, tally),
+        };
+        match self.scene.image.clamp {
+            Some(most) => clamp_sample(radiance, most),
+            None => radiance,
         }
     }
 
@@ -366,6 +370,20 @@ struct TileOutput {
     pixels: Vec<Vec3>,
     stats: RenderStats,
     cost: Vec<u64>,
+}
+
+/// A sample's radiance with its largest component at most `most`, scaled down as a whole so that
+/// its hue stays (pbrt-v4's `maxComponentValue`): the clamp against fireflies, a bias traded for
+/// less noise. NaN components are left for the film to show.
+pub fn clamp_sample(radiance: Vec3, most: f32) -> Vec3 {
+    let largest = radiance.max_element();
+    if !(largest > most) {
+        radiance
+    } else if largest.is_finite() {
+        radiance * (most / largest)
+    } else {
+        radiance.min(Vec3::splat(most))
+    }
 }
 
 /// The sample generator of one pixel: depends on the seed and the pixel only, never on threads.

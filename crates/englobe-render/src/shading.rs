@@ -6,6 +6,8 @@
 //! a point light of intensity `I` at distance `d` reflects `I / d²`, so a diffuse surface's
 //! response to a light is `diffuse * cos θ * radiance`, with no `1 / π` (the path tracer uses the
 //! same response, which amounts to reading the scene's intensities as `π` times a radiant intensity).
+//! Emission (emissive triangles and spheres) and the environment are radiances instead: the path
+//! tracer reflects them with the BSDF `diffuse / π` (see [`crate::light_sampling`]).
 
 use englobe::{Counters, Object, Ray, Vec3, World, WorldHit};
 use englobe_scene::{Light, Material, MaterialModel, Scene, SurfaceParams};

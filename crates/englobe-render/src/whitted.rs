@@ -9,6 +9,9 @@
 //! (1 under total internal reflection). A material with `kt = 1`, index 1 and no highlight is thus
 //! exactly invisible: its colour is `T`, and `T` is the colour behind it.
 //!
+//! Rays that hit nothing see the scene's environment (looked up, never sampled: the lights are
+//! the point and directional ones), or its background.
+//!
 //! Adaptive depth (Hall and Greenberg 1983, "A Testbed for Realistic Image Synthesis"): a
 //! secondary ray's contribution to its pixel is the product of the factors (`kr`, `kt (1 - F)`,
 //! ...) along its path; with the scene's `min_contribution`, a ray whose contribution would fall
@@ -21,6 +24,7 @@
 use englobe::{Counters, Ray, Vec3, World};
 use englobe_scene::Scene;
 
+use crate::environment::EnvironmentLight;
 use crate::optics::{fresnel_dielectric, reflect, refract};
 use crate::shading::Surface;
 use crate::stats::{RayKind, Tally};
@@ -31,12 +35,18 @@ pub struct Whitted<'a> {
     scene: &'a Scene,
     world: &'a World,
     vis: Visibility<'a>,
+    environment: Option<EnvironmentLight>,
 }
 
 impl<'a> Whitted<'a> {
     /// The integrator. `world` must hold the scene's objects in the scene's order.
     pub fn new(scene: &'a Scene, world: &'a World) -> Self {
-        Whitted { scene, world, vis: Visibility::new(scene, world) }
+        Whitted {
+            scene,
+            world,
+            vis: Visibility::new(scene, world),
+            environment: scene.environment.as_ref().map(EnvironmentLight::new),
+        }
     }
 
     /// The colour seen along a primary `ray`.
@@ -49,7 +59,7 @@ impl<'a> Whitted<'a> {
     fn trace<C: Counters>(&self, ray: &Ray, kind: RayKind, depth: u32, weight: f32, tally: &mut Tally<C>) -> Vec3 {
         tally.rays[kind as usize] += 1;
         let Some(hit) = self.vis.closest_hit(ray, &mut tally.work[kind as usize]) else {
-            return self.scene.image.background;
+            return self.environment.as_ref().map_or(self.scene.image.background, |e| e.radiance(ray.dir()));
         };
         let s = Surface::at(self.scene, self.world, ray, &hit);
         let m = s.material;

@@ -82,6 +82,7 @@ fn tiles_on_disk_assemble_to_the_same_bytes() {
                         scene_digest: "0".repeat(64),
                         version: VERSION.into(),
                         tile: Some(spec),
+                        output: Default::default(),
                     };
                     let path = dir.path().join(format!("tile-{}-{count}.exr", spec.index));
                     write_tile(&path, &header, &render(&s, Some(window))).unwrap();

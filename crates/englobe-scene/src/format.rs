@@ -35,6 +35,9 @@ pub struct SceneFile {
     pub random_triangles: Vec<Spanned<RandomTrianglesDef>>,
     #[serde(default)]
     pub mesh: Vec<Spanned<MeshDef>>,
+    #[serde(default)]
+    pub rectangle: Vec<Spanned<RectangleDef>>,
+    pub environment: Option<Spanned<EnvironmentDef>>,
 }
 
 fn one() -> u32 {
@@ -60,6 +63,12 @@ pub struct ImageDef {
     pub seed: u64,
     #[serde(default)]
     pub integrator: crate::model::IntegratorKind,
+    pub exposure: Option<Spanned<Finite>>,
+    #[serde(default)]
+    pub tonemap: crate::model::ToneMap,
+    #[serde(default)]
+    pub exr_half: bool,
+    pub clamp: Option<Positive>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -245,4 +254,28 @@ pub struct GridDef {
     pub spacing: Point,
     pub origin: Option<Point>,
     pub rotate_step: Option<Point>,
+}
+
+/// A parallelogram (two triangles): `corner`, `corner + edge1`, `corner + edge1 + edge2`,
+/// `corner + edge2`, facing `edge1 x edge2`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RectangleDef {
+    pub corner: Point,
+    pub edge1: Point,
+    pub edge2: Point,
+    pub material: Option<Spanned<String>>,
+}
+
+/// The `[environment]` table: exactly one of `file`, `color`, or `zenith` with `horizon`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EnvironmentDef {
+    pub file: Option<Spanned<String>>,
+    pub color: Option<Spanned<Color>>,
+    pub zenith: Option<Spanned<Color>>,
+    pub horizon: Option<Spanned<Color>>,
+    pub ground: Option<Spanned<Color>>,
+    pub intensity: Option<NonNegative>,
+    pub rotation: Option<Finite>,
 }

@@ -5,6 +5,7 @@
 //! glTF 2.0). A bad file is refused with an error that names the file, the line (or byte) and
 //! says what was expected; nothing here panics on user input.
 
+pub mod environment;
 pub mod error;
 pub mod format;
 pub mod framing;
@@ -15,12 +16,14 @@ pub mod model;
 pub mod numbers;
 pub mod overrides;
 pub mod parse;
+mod parse_environment;
 mod parse_material;
 mod parse_mesh;
 pub mod random_triangles;
 pub mod shared_data;
 pub mod texture;
 
+pub use environment::{Environment, EnvironmentMap, Sky};
 pub use error::{Located, SceneError};
 pub use material::{
     Alpha, AlphaMode, Channel, MaterialModel, MaterialTextures, NormalEncoding, NormalMap, ScalarTexture, TextureRef,
@@ -28,8 +31,8 @@ pub use material::{
 };
 pub use material_eval::{MISSING_TEXTURE_COLOR, SurfaceParams};
 pub use model::{
-    Camera, ImageSettings, IntegratorKind, Light, MAX_DEPTH, MAX_PIXELS, MAX_SAMPLES, Material, MaterialId, Projection,
-    Scene, SceneObject,
+    Camera, ImageSettings, IntegratorKind, Light, MAX_DEPTH, MAX_PIXELS, MAX_SAMPLES, Material, MaterialId,
+    OutputSettings, Projection, Scene, SceneObject, ToneMap,
 };
 pub use overrides::Override;
 pub use parse::{DEFAULT_MATERIAL, load_scene, load_scene_with, parse_scene, parse_scene_with};

@@ -40,6 +40,48 @@ pub struct ImageSettings {
     pub seed: u64,
     /// How light is computed.
     pub integrator: IntegratorKind,
+    /// Largest component a sample's radiance may have (against fireflies): a sample above it is
+    /// scaled down to it, keeping its hue; `None` (the default) leaves samples as they are.
+    /// It changes the pixels, so tiles' digests cover it.
+    pub clamp: Option<f32>,
+    /// How the linear image is written (exposure and tone map for PNG, half floats for EXR):
+    /// no pixel value depends on it, so tiles' digests leave it out.
+    pub output: OutputSettings,
+}
+
+/// How a linear image becomes a file.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct OutputSettings {
+    /// Exposure in stops (EV): PNG values are multiplied by `2^exposure` before the tone map.
+    pub exposure: f32,
+    /// The curve from exposed linear values to display values, for PNG.
+    pub tonemap: ToneMap,
+    /// OpenEXR output in 16-bit half floats instead of 32-bit floats.
+    pub exr_half: bool,
+}
+
+/// Largest exposure, in stops, either way.
+pub const MAX_EXPOSURE: f32 = 64.0;
+
+/// A tone map: how exposed linear radiance becomes a display value in `0..=1` (before sRGB).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Deserialize, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ToneMap {
+    /// Values are clipped to `0..=1` (englobe's images before tone maps existed).
+    #[default]
+    None,
+    /// An ACES-like filmic curve (Narkowicz 2016's fit of the ACES RRT and ODT).
+    Filmic,
+}
+
+impl ToneMap {
+    /// The name used in scene files and on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            ToneMap::None => "none",
+            ToneMap::Filmic => "filmic",
+        }
+    }
 }
 
 /// The light transport algorithm.
@@ -246,6 +288,9 @@ pub struct Scene {
     pub textures: Vec<Arc<Texture>>,
     /// Objects.
     pub objects: Vec<SceneObject>,
+    /// The light from infinitely far away that escaping rays see (replaces the image's
+    /// `background`), if the scene has an `[environment]`.
+    pub environment: Option<crate::environment::Environment>,
     /// What was skipped or repaired while loading (from mesh files, mostly), for the user.
     pub warnings: Vec<String>,
 }

@@ -170,12 +170,37 @@ impl Converter<'_> {
             }
             push(tri.into(), lookup(&t.material)?);
         }
+        for r in def.rectangle {
+            let span = r.span();
+            let r = r.into_inner();
+            let (c, e1, e2) = (r.corner.0, r.edge1.0, r.edge2.0);
+            let material = lookup(&r.material)?;
+            for [a, b, d] in [[c, c + e1, c + e1 + e2], [c, c + e1 + e2, c + e2]] {
+                let tri = Triangle::new(a, b, d);
+                if tri.is_degenerate() || !(a + b + d).is_finite() {
+                    return Err(self.err(
+                        span,
+                        "a rectangle needs two edges that are not zero, not parallel, and within 32-bit floats",
+                    ));
+                }
+                push(tri.into(), material);
+            }
+        }
         for r in def.random_triangles {
             let material = lookup(&r.get_ref().material)?;
             push(self.random_triangles(r)?, material);
         }
-        let mut scene = Scene { image, camera, lights, materials, material_names, textures, objects, warnings };
+        let mut scene =
+            Scene { image, camera, lights, materials, material_names, textures, objects, environment: None, warnings };
         self.meshes(def.mesh, &mut scene)?;
+        if let Some(env) = def.environment {
+            scene.environment = Some(self.environment(env)?);
+            if scene.image.background != Vec3::ZERO {
+                scene
+                    .warnings
+                    .push("the scene has an [environment]: rays that escape see it, not the [image] background".into());
+            }
+        }
         Ok(scene)
     }
 
@@ -193,6 +218,20 @@ impl Converter<'_> {
             };
             self.err(at, message)
         })?;
+        let exposure = match i.exposure {
+            Some(e) if e.get_ref().0.abs() > crate::model::MAX_EXPOSURE => {
+                return Err(self.err(
+                    e.span(),
+                    format!(
+                        "an exposure of {} stops: expected -{max} to {max}",
+                        e.get_ref().0,
+                        max = crate::model::MAX_EXPOSURE
+                    ),
+                ));
+            }
+            Some(e) => e.get_ref().0,
+            None => 0.0,
+        };
         Ok(ImageSettings {
             width,
             height,
@@ -203,6 +242,8 @@ impl Converter<'_> {
             ambient: i.ambient.map_or(Vec3::ZERO, |c| c.0),
             seed: i.seed,
             integrator: i.integrator,
+            clamp: i.clamp.map(|c| c.0),
+            output: crate::model::OutputSettings { exposure, tonemap: i.tonemap, exr_half: i.exr_half },
         })
     }
 

@@ -261,3 +261,33 @@ fn metallic_roughness_materials_and_their_defaults() {
         (englobe_scene::MaterialModel::Classic, true, englobe_scene::AlphaMode::Opaque)
     );
 }
+
+#[test]
+fn rectangles_and_output_settings_are_checked() {
+    let flat = format!("{GOOD}\n[[rectangle]]\ncorner = [0, 0, 0]\nedge1 = [1, 0, 0]\nedge2 = [2, 0, 0]\n");
+    let e = error_of(&flat);
+    assert_eq!(e.line, flat.lines().position(|l| l == "[[rectangle]]").unwrap() + 1, "{e}");
+    assert!(e.message.contains("not parallel"), "{e}");
+    let good = format!("{GOOD}\n[[rectangle]]\ncorner = [0, 0, 0]\nedge1 = [1, 0, 0]\nedge2 = [0, 0, 2]\n");
+    let s = parse_scene(&good, "good.toml".as_ref()).unwrap();
+    assert_eq!(s.objects.len(), 3, "a sphere and the rectangle's two triangles");
+    for (key, expected) in [
+        ("exposure = 65", "an exposure of 65 stops"),
+        ("tonemap = \"aces\"", "unknown variant"),
+        ("clamp = 0", "greater than 0"),
+        ("exr_half = 1", "expected a boolean"),
+    ] {
+        let text = GOOD.replace("height = 48\n", &format!("height = 48\n{key}\n"));
+        let e = error_of(&text);
+        assert_eq!(e.line, 5, "{key}: {e}");
+        assert!(e.message.contains(expected), "{key}: {e}");
+    }
+    let text = GOOD
+        .replace("height = 48\n", "height = 48\nexposure = -2.5\ntonemap = \"filmic\"\nexr_half = true\nclamp = 10\n");
+    let s = parse_scene(&text, "good.toml".as_ref()).unwrap();
+    assert_eq!(s.image.clamp, Some(10.0));
+    assert_eq!(
+        s.image.output,
+        englobe_scene::OutputSettings { exposure: -2.5, tonemap: englobe_scene::ToneMap::Filmic, exr_half: true }
+    );
+}

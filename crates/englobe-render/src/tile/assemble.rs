@@ -7,6 +7,8 @@ use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
+use englobe_scene::OutputSettings;
+
 use super::file::TileHeader;
 use super::{PixelWindow, TileSpec};
 use crate::film::Film;
@@ -47,6 +49,23 @@ pub fn missing_tiles(tiles: &[Tile], count: Option<u32>) -> Vec<TileSpec> {
     }
     let present: std::collections::HashSet<u32> = tiles.iter().filter_map(|t| t.header.tile.map(|s| s.index)).collect();
     TileSpec::all(count).filter(|t| !present.contains(&t.index)).collect()
+}
+
+/// How the tiles ask the assembled image to be written: the output settings they all record, or
+/// why there is no one answer (tiles of one render written with different settings, such as a
+/// run repeated with another exposure: the caller must choose).
+pub fn output_settings(tiles: &[Tile]) -> Result<OutputSettings, String> {
+    let Some(first) = tiles.first() else { return Ok(OutputSettings::default()) };
+    match tiles.iter().find(|t| t.header.output != first.header.output) {
+        None => Ok(first.header.output),
+        Some(other) => Err(format!(
+            "the tiles ask for different output settings: {} has `{}`, {} has `{}`",
+            first.path.display(),
+            super::file::output_text(&first.header.output),
+            other.path.display(),
+            super::file::output_text(&other.header.output)
+        )),
+    }
 }
 
 /// The whole image from its tiles, or every reason it cannot be made.
@@ -228,9 +247,24 @@ mod tests {
                 scene_digest: scene.repeat(64 / scene.len()),
                 version: "1".into(),
                 tile: Some(spec),
+                output: Default::default(),
             },
             film,
         }
+    }
+
+    #[test]
+    fn tiles_agree_on_the_output_settings_or_say_they_do_not() {
+        let mut tiles = cut(3);
+        assert_eq!(output_settings(&tiles), Ok(OutputSettings::default()));
+        for t in &mut tiles {
+            t.header.output.exposure = 1.5;
+        }
+        assert_eq!(output_settings(&tiles).unwrap().exposure, 1.5);
+        tiles[2].header.output.tonemap = englobe_scene::ToneMap::Filmic;
+        let e = output_settings(&tiles).unwrap_err();
+        assert!(e.contains("t0.exr") && e.contains("t2.exr") && e.contains("tonemap=filmic"), "{e}");
+        assert!(assemble(&tiles).is_ok(), "the pixels still assemble");
     }
 
     fn cut(count: u32) -> Vec<Tile> {

@@ -14,6 +14,8 @@ use exr::prelude::{Image, Layer, LayerAttributes, ReadChannels, ReadLayers, Spec
 use super::{PixelWindow, TileSpec};
 use crate::film::Film;
 use crate::output::{EXR_ENCODING, OutputError, write_atomically};
+use englobe_scene::model::MAX_EXPOSURE;
+use englobe_scene::{OutputSettings, ToneMap};
 
 /// The version of englobe that tiles record and assembly compares.
 pub const VERSION: &str = env!("CARGO_PKG_VERSION");
@@ -22,9 +24,10 @@ const VERSION_KEY: &str = "englobeVersion";
 const SCENE_KEY: &str = "englobeScene";
 const TILE_KEY: &str = "englobeTile";
 const CONTENT_KEY: &str = "englobeContent";
+const OUTPUT_KEY: &str = "englobeOutput";
 
 /// What a tile says about itself.
-#[derive(Clone, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct TileHeader {
     /// Size of the whole image.
     pub full_width: u32,
@@ -38,6 +41,33 @@ pub struct TileHeader {
     pub version: String,
     /// Its place in a cut, if it was rendered as `--tile K/N`.
     pub tile: Option<TileSpec>,
+    /// How the assembled image is to be written (exposure, tone map, half floats): the render's
+    /// choice, which changes no pixel of the tile, so assembly uses it unless told otherwise.
+    pub output: OutputSettings,
+}
+
+/// The text of `output` in a tile's header: `exposure=EV tonemap=NAME half=BOOL`, the exposure
+/// in the shortest form that reads back to the same `f32`.
+pub fn output_text(output: &OutputSettings) -> String {
+    format!("exposure={:?} tonemap={} half={}", output.exposure, output.tonemap.name(), output.exr_half)
+}
+
+/// Reads [`output_text`]'s form back; anything else is refused with what was expected.
+pub fn parse_output_text(text: &str) -> Result<OutputSettings, String> {
+    let expected = || format!("output settings `{text}`: expected `exposure=EV tonemap=none|filmic half=true|false`");
+    let mut parts = text.split(' ');
+    let mut field = |key: &str| parts.next().and_then(|p| p.strip_prefix(key)).and_then(|p| p.strip_prefix('='));
+    let exposure = field("exposure").and_then(|e| e.parse::<f32>().ok()).filter(|e| e.abs() <= MAX_EXPOSURE);
+    let tonemap = match field("tonemap") {
+        Some("none") => Some(ToneMap::None),
+        Some("filmic") => Some(ToneMap::Filmic),
+        _ => None,
+    };
+    let half = field("half").and_then(|h| h.parse::<bool>().ok());
+    match (exposure, tonemap, half, parts.next()) {
+        (Some(exposure), Some(tonemap), Some(exr_half), None) => Ok(OutputSettings { exposure, tonemap, exr_half }),
+        _ => Err(expected()),
+    }
 }
 
 /// Why a tile could not be written or read.
@@ -92,6 +122,7 @@ pub fn write_tile(path: &Path, header: &TileHeader, film: &Film) -> Result<(), T
     text(VERSION_KEY, header.version.clone());
     text(SCENE_KEY, header.scene_digest.clone());
     text(CONTENT_KEY, content_digest(header, pixels));
+    text(OUTPUT_KEY, output_text(&header.output));
     if let Some(tile) = header.tile {
         text(TILE_KEY, tile.to_string());
     }
@@ -172,6 +203,7 @@ pub fn read_tile_from(
         scene_digest: text(SCENE_KEY)?,
         version: text(VERSION_KEY)?,
         tile,
+        output: parse_output_text(&text(OUTPUT_KEY)?).map_err(invalid)?,
     };
     let expected_content = text(CONTENT_KEY)?;
 
@@ -211,8 +243,13 @@ fn content_digest(header: &TileHeader, pixels: &[Vec3]) -> String {
     let mut h = blake3::Hasher::new();
     let tile = header.tile.map(|t| t.to_string()).unwrap_or_default();
     let what = format!(
-        "{}x{} {} {} {} {tile}|",
-        header.full_width, header.full_height, header.window, header.scene_digest, header.version
+        "{}x{} {} {} {} {tile} {}|",
+        header.full_width,
+        header.full_height,
+        header.window,
+        header.scene_digest,
+        header.version,
+        output_text(&header.output)
     );
     h.update(what.as_bytes());
     for p in pixels {
@@ -235,6 +272,7 @@ mod tests {
             scene_digest: "ab".repeat(32),
             version: VERSION.into(),
             tile: Some(TileSpec { index: 1, count: 3 }),
+            output: OutputSettings { exposure: -1.25, tonemap: ToneMap::Filmic, exr_half: true },
         }
     }
 
@@ -261,6 +299,29 @@ mod tests {
             f2.pixels().iter().map(|p| p.to_array().map(f32::to_bits)).collect::<Vec<_>>(),
             f.pixels().iter().map(|p| p.to_array().map(f32::to_bits)).collect::<Vec<_>>()
         );
+    }
+
+    #[test]
+    fn output_settings_read_back_exactly_and_bad_ones_are_refused() {
+        for output in [
+            OutputSettings::default(),
+            OutputSettings { exposure: 0.1, tonemap: ToneMap::Filmic, exr_half: true },
+            OutputSettings { exposure: -63.999, tonemap: ToneMap::None, exr_half: false },
+        ] {
+            assert_eq!(parse_output_text(&output_text(&output)), Ok(output));
+        }
+        assert_eq!(output_text(&OutputSettings::default()), "exposure=0.0 tonemap=none half=false");
+        for bad in [
+            "",
+            "exposure=1 tonemap=none",
+            "exposure=1 tonemap=aces half=false",
+            "exposure=99 tonemap=none half=false",
+            "exposure=NaN tonemap=none half=false",
+            "exposure=0 tonemap=none half=false extra",
+            "tonemap=none exposure=0 half=false",
+        ] {
+            assert!(parse_output_text(bad).unwrap_err().contains("expected `exposure=EV"), "{bad}");
+        }
     }
 
     #[test]
