@@ -214,28 +214,25 @@ mod tests {
         }
     }
 
-    /// The probability that filter `f`'s offset on the x axis falls in `[a, b]`, from its shape's
-    /// distribution function in closed form.
-    fn probability(f: &PixelFilter, a: f64, b: f64) -> f64 {
+    /// The distribution function of filter `f`'s offset on the x axis, in closed form (the
+    /// Gaussian's through the error function).
+    fn distribution(f: &PixelFilter) -> impl Fn(f64) -> f64 {
         let r = f.radius().x as f64;
-        let cdf = |x: f64| -> f64 {
-            let x = x.clamp(-r, r);
-            match f {
-                PixelFilter::Box { .. } => (x + r) / (2.0 * r),
-                PixelFilter::Triangle { .. } => {
-                    if x < 0.0 {
-                        (x + r).powi(2) / (2.0 * r * r)
-                    } else {
-                        1.0 - (r - x).powi(2) / (2.0 * r * r)
-                    }
-                }
-                PixelFilter::Gaussian { sigma, .. } => {
-                    let g = GaussianAxis::new(r as f32, *sigma);
-                    g.cdf(x) / g.total
-                }
-            }
+        let gaussian = match *f {
+            PixelFilter::Gaussian { sigma, .. } => Some(GaussianAxis::new(r as f32, sigma)),
+            _ => None,
         };
-        cdf(b) - cdf(a)
+        let f = *f;
+        move |x: f64| -> f64 {
+            let x = x.clamp(-r, r);
+            match (f, &gaussian) {
+                (PixelFilter::Box { .. }, _) => (x + r) / (2.0 * r),
+                (PixelFilter::Triangle { .. }, _) if x < 0.0 => (x + r).powi(2) / (2.0 * r * r),
+                (PixelFilter::Triangle { .. }, _) => 1.0 - (r - x).powi(2) / (2.0 * r * r),
+                (_, Some(g)) => g.cdf(x) / g.total,
+                (_, None) => unreachable!("a Gaussian has its axis"),
+            }
+        }
     }
 
     /// Pearson's chi-square of `n` offsets of `f` against its shape, in `bins` equal bins over
@@ -243,6 +240,7 @@ mod tests {
     /// functions (Kolmogorov's statistic times sqrt(n)).
     fn fit(f: &PixelFilter, n: usize, bins: usize) -> (f64, f64) {
         let sampler = FilterSampler::new(f);
+        let cdf = distribution(f);
         let r = f.radius().x as f64;
         let mut rng = Pcg32::seed_from_u64(2024);
         let mut counts = vec![0usize; bins];
@@ -261,7 +259,7 @@ mod tests {
             .enumerate()
             .map(|(i, &c)| {
                 let a = -r + i as f64 * width;
-                let e = n as f64 * probability(f, a, a + width);
+                let e = n as f64 * (cdf(a + width) - cdf(a));
                 (c as f64 - e).powi(2) / e
             })
             .sum();
@@ -270,7 +268,7 @@ mod tests {
             .iter()
             .enumerate()
             .map(|(i, &x)| {
-                let exact = probability(f, -r, x);
+                let exact = cdf(x);
                 (exact - i as f64 / n as f64).abs().max((exact - (i + 1) as f64 / n as f64).abs())
             })
             .fold(0.0, f64::max);

@@ -52,13 +52,15 @@ impl Builder {
     /// The image settings and the camera. `bounds` (the scene's) places the camera's look-at
     /// point on its view axis nearest the scene's centre.
     pub fn image_and_camera(&mut self, bounds: Aabb) -> Res<(ImageSettings, Camera)> {
+        let film_at = self.film.as_ref().map_or(Place::START, |d| d.at);
+        let sampler_at = self.sampler.as_ref().map_or(film_at, |d| d.at);
         let (width, height) = self.film_size()?;
         let (samples, seed) = self.sampler_options()?;
         let max_depth = self.integrator_options()?;
         let filter = self.pixel_filter()?;
         if let Err(message) = ImageSettings::check_limits(width, height, samples, max_depth) {
-            let at = self.film.as_ref().or(self.sampler.as_ref()).map_or(Place::START, |d| d.at);
-            return fail(at, message);
+            let size_ok = ImageSettings::check_limits(width, height, 1, 0).is_ok();
+            return fail(if size_ok { sampler_at } else { film_at }, message);
         }
         let camera = self.camera_settings(width, height, bounds)?;
         let image = ImageSettings {
