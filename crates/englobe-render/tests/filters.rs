@@ -77,11 +77,14 @@ fn the_default_filter_is_the_box_of_half_a_pixel() {
     assert_ne!(bits(&implicit), bits(&wide), "a wider filter changes the picture");
 }
 
+/// A filter's shape along one axis.
+type Shape = Box<dyn Fn(f64) -> f64>;
+
 #[test]
 fn an_edge_is_blurred_by_the_filters_distribution() {
     let samples = 4096;
     let gauss = |x: f64| ((-x * x / (2.0 * 0.5 * 0.5)).exp() - (-1.5f64 * 1.5 / (2.0 * 0.5 * 0.5)).exp()).max(0.0);
-    let cases: [(&str, Box<dyn Fn(f64) -> f64>, f64); 3] = [
+    let cases: [(&str, Shape, f64); 3] = [
         ("filter = \"box\"", Box::new(|_| 1.0), 0.5),
         ("filter = \"triangle\"\nfilter_radius = 2", Box::new(|x: f64| (2.0 - x.abs()).max(0.0)), 2.0),
         ("filter = \"gaussian\"", Box::new(gauss), 1.5),

@@ -6,6 +6,9 @@ use std::sync::Arc;
 
 use englobe::{Object, Vec3};
 
+/// Name of the material objects get when they name none.
+pub const DEFAULT_MATERIAL: &str = "default";
+
 /// Largest image, in pixels (2^28: a 16384 x 16384 image), refused before anything is allocated.
 pub const MAX_PIXELS: u64 = 1 << 28;
 /// Most samples per pixel.

@@ -17,8 +17,7 @@ use crate::model::{Camera, ImageSettings, Light, Material, MaterialId, Projectio
 use crate::overrides::{Override, Placed};
 use crate::pixel_filter::{MAX_FILTER_RADIUS, PixelFilter};
 
-/// Name of the material objects get when they name none.
-pub const DEFAULT_MATERIAL: &str = "default";
+pub use crate::model::DEFAULT_MATERIAL;
 /// Most spheres one `[[sphere_grid]]` may generate.
 pub const MAX_GRID_SPHERES: u64 = 1 << 24;
 /// Largest scene file read.

@@ -11,9 +11,9 @@ use std::sync::Arc;
 use englobe::{Object, TriangleMesh, Vec3};
 use glam::DMat4;
 
-use super::materials::default_material;
 use super::report::Report;
 use super::source::{Place, Res, Sources, fail};
+use super::values::{Texture, default_material};
 use crate::model::{Light, Material, MaterialId};
 
 /// Which of a `TransformTimes` pair the transformation directives change.
@@ -109,7 +109,7 @@ pub(super) struct Builder {
     /// `Option "integer seed"`.
     pub option_seed: Option<u64>,
     pub named_materials: HashMap<String, MaterialId>,
-    pub textures: HashMap<String, super::textures::Texture>,
+    pub textures: HashMap<String, Texture>,
     pub materials: Vec<Material>,
     pub material_names: Vec<String>,
     /// Materials that pbrt's `interface` type makes (boundaries of media only): their shapes are
@@ -155,7 +155,7 @@ impl Builder {
             named_materials: HashMap::new(),
             textures: HashMap::new(),
             materials: vec![default_material()],
-            material_names: vec![crate::parse::DEFAULT_MATERIAL.to_owned()],
+            material_names: vec![crate::model::DEFAULT_MATERIAL.to_owned()],
             invisible: vec![false],
             placed: Vec::new(),
             lights: Vec::new(),

@@ -10,19 +10,7 @@ use super::builder::Builder;
 use super::params::{Param, Params, Type, Values};
 use super::source::{Res, fail};
 use super::spectrum::{blackbody_rgb, sampled_rgb};
-use super::textures::TexValue;
-
-/// What a colour stands for, which decides its range and how spectra become RGB.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(super) enum Role {
-    /// A reflectance or transmittance, in `0..=1`.
-    Reflectance,
-    /// A physical constant such as a conductor's `eta` and `k`: any value of at least 0.
-    Unbounded,
-    /// A light's spectrum: pbrt-v4 normalises it to luminance 1, except RGB values, which it
-    /// keeps as they are (their illuminant is normalised, not their colour).
-    Light,
-}
+use super::values::{Role, TexValue};
 
 /// Linear sRGB of a named spectrum, where englobe knows it: the sRGB white (D65) and CIE
 /// illuminant A (a black body at 2856 K by definition) as lights.

@@ -15,9 +15,9 @@ use englobe::Vec3;
 use glam::DVec3;
 
 use super::builder::{AreaLight, Builder};
-use super::color::Role;
 use super::params::Params;
 use super::source::{Place, Res, fail};
+use super::values::Role;
 use crate::model::Light;
 
 const PI: f64 = std::f64::consts::PI;

@@ -16,15 +16,10 @@
 use englobe::Vec3;
 
 use super::builder::{Builder, MatRef};
-use super::color::Role;
 use super::params::{Params, Type, Values};
 use super::source::{Place, Res, fail};
+use super::values::{Role, default_material};
 use crate::model::{Material, MaterialId};
-
-/// pbrt's material for shapes that name none: `diffuse` with reflectance 0.5.
-pub(super) fn default_material() -> Material {
-    Material { diffuse: Vec3::splat(0.5), ..Material::default() }
-}
 
 /// A black, non-reflecting material with the given parts set afterwards.
 fn black() -> Material {
@@ -370,8 +365,7 @@ impl Builder {
             }
             "diffusetransmission" | "translucent" => {
                 let name = if kind == "translucent" { "Kd" } else { "reflectance" };
-                let default = if kind == "translucent" { 0.25 } else { 0.25 };
-                let r = self.color(params, name, Role::Reflectance, what)?.unwrap_or(Vec3::splat(default));
+                let r = self.color(params, name, Role::Reflectance, what)?.unwrap_or(Vec3::splat(0.25));
                 for p in ["transmittance", "Ks", "reflect", "transmit", "roughness", "scale"] {
                     params.touch(p);
                 }

@@ -44,6 +44,7 @@ mod source;
 mod spectrum;
 mod textures;
 mod transform;
+mod values;
 
 use std::path::Path;
 

@@ -7,29 +7,9 @@
 use englobe::Vec3;
 
 use super::builder::Builder;
-use super::color::Role;
 use super::params::{Param, Params};
 use super::source::{Place, Res, fail};
-
-/// A texture's one value.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub(super) enum TexValue {
-    Color(Vec3),
-    Float(f64),
-}
-
-/// A texture as englobe keeps it.
-#[derive(Clone, Debug)]
-pub(super) struct Texture {
-    /// Its value, when it has one.
-    pub value: Option<TexValue>,
-    pub class: String,
-}
-
-/// Key of a texture: pbrt-v4 keeps float and spectrum textures apart.
-pub(super) fn key(name: &str, float: bool) -> String {
-    format!("{}:{name}", if float { "float" } else { "spectrum" })
-}
+use super::values::{Role, TexValue, Texture, key};
 
 impl Builder {
     /// The `Texture` directive.
