@@ -47,7 +47,8 @@ fn render_draws_the_cornell_box_from_its_file_and_refuses_overrides() {
     let cornell = scenes().join("cornell-bitterli/scene-v4.pbrt");
     let dir = tempfile::tempdir().unwrap();
     let png = dir.path().join("cornell.png");
-    let out = englobe(&["render", cornell.to_str().unwrap(), "--width", "24", "--spp", "4", "-o", png.to_str().unwrap()]);
+    let out =
+        englobe(&["render", cornell.to_str().unwrap(), "--width", "24", "--spp", "4", "-o", png.to_str().unwrap()]);
     assert!(out.status.success(), "{}", text(&out.stderr));
     assert!(text(&out.stdout).contains("24x24, 4 spp, path"), "{}", text(&out.stdout));
     assert!(text(&out.stderr).contains("warning: ") && text(&out.stderr).contains("cornell-box.png"));

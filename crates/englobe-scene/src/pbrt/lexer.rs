@@ -30,14 +30,14 @@ pub(super) struct Token {
 
 /// The tokens of one file, one at a time.
 pub(super) struct Lexer {
-    text: Arc<str>,
+    text: Arc<String>,
     file: u32,
     pos: usize,
     peeked: Option<Token>,
 }
 
 impl Lexer {
-    pub fn new(text: Arc<str>, file: u32) -> Self {
+    pub fn new(text: Arc<String>, file: u32) -> Self {
         Lexer { text, file, pos: 0, peeked: None }
     }
 
@@ -176,7 +176,7 @@ mod tests {
     use super::*;
 
     fn tokens(text: &str) -> Vec<(Kind, String)> {
-        let mut lex = Lexer::new(text.into(), 0);
+        let mut lex = Lexer::new(Arc::new(text.to_owned()), 0);
         let mut out = Vec::new();
         while let Some(t) = lex.next().unwrap() {
             out.push((t.kind, lex.string(&t).into_owned()));
@@ -209,7 +209,7 @@ mod tests {
     #[test]
     fn a_string_must_end_on_its_line() {
         for text in ["Shape \"sphere", "Shape \"sph\nere\"", "\"a\\"] {
-            let mut lex = Lexer::new(text.into(), 0);
+            let mut lex = Lexer::new(Arc::new(text.to_owned()), 0);
             let mut result = Ok(None);
             for _ in 0..3 {
                 result = lex.next();

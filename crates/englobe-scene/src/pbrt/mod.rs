@@ -65,14 +65,18 @@ pub fn is_pbrt_path(path: &Path) -> bool {
 /// [`Scene::warnings`].
 pub fn load(path: &Path, strict: bool) -> Result<Scene, SceneError> {
     let text = source::read_text(path).map_err(|e| SceneError::io(path, e))?;
-    parse(&text, path, strict)
+    parse_owned(text, path, strict)
 }
 
 /// Reads pbrt scene `text`, which `file` names in messages; relative file names in it are
 /// resolved against `file`'s folder.
 pub fn parse(text: &str, file: &Path, strict: bool) -> Result<Scene, SceneError> {
+    parse_owned(text.to_owned(), file, strict)
+}
+
+fn parse_owned(text: String, file: &Path, strict: bool) -> Result<Scene, SceneError> {
     let mut sources = source::Sources::default();
-    let id = sources.add(file.display().to_string(), file.to_owned(), text.to_owned(), None);
+    let id = sources.add(file.display().to_string(), file.to_owned(), text, None);
     let search_dir = file.parent().unwrap_or(Path::new("")).to_owned();
     let mut parser = parser::Parser::new(builder::Builder::new(sources, strict, search_dir), id);
     let result = parser.run().and_then(|()| parser.b.finish());

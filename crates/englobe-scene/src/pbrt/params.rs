@@ -339,7 +339,7 @@ mod tests {
     use super::*;
 
     fn params(text: &str) -> Res<Params> {
-        let mut lex = Lexer::new(text.into(), 0);
+        let mut lex = Lexer::new(std::sync::Arc::new(text.to_owned()), 0);
         parse_params(&mut lex)
     }
 

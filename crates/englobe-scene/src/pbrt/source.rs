@@ -47,7 +47,7 @@ pub(super) struct Source {
     pub name: String,
     /// Where it is, for resolving the files it names (empty for text given in memory).
     pub path: PathBuf,
-    pub text: Arc<str>,
+    pub text: Arc<String>,
     /// The `Include` or `Import` that named it.
     pub from: Option<Place>,
 }
@@ -63,7 +63,7 @@ impl Sources {
     /// Adds a file's text; returns its number.
     pub fn add(&mut self, name: String, path: PathBuf, text: String, from: Option<Place>) -> u32 {
         self.total_bytes += text.len() as u64;
-        self.files.push(Source { name, path, text: text.into(), from });
+        self.files.push(Source { name, path, text: Arc::new(text), from });
         (self.files.len() - 1) as u32
     }
 
