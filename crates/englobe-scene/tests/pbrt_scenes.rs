@@ -261,6 +261,53 @@ fn includes_and_imports_read_files_beside_the_scene() {
 }
 
 #[test]
+fn meshes_of_every_kind_are_read() {
+    let dir = tempfile::tempdir().unwrap();
+    let ply = "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n\
+               element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n";
+    std::fs::create_dir(dir.path().join("geometry")).unwrap();
+    std::fs::write(dir.path().join("geometry/quad.ply"), ply).unwrap();
+    let main = dir.path().join("main.pbrt");
+    let text = "WorldBegin\nTranslate 0 0 2\nShape \"plymesh\" \"string filename\" \"geometry/quad.ply\"\n\
+                Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0] \"point2 uv\" [0 0 1 0 0 1]\n\
+                Shape \"bilinearmesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0 1 1 0]\n\
+                Shape \"disk\" \"float radius\" 2\n\
+                Shape \"plymesh\" \"string filename\" \"geometry/quad.ply\"\n";
+    std::fs::write(&main, text).unwrap();
+    let s = load(&main, false).unwrap_or_else(|e| panic!("{e}"));
+    let meshes: Vec<_> = s
+        .objects
+        .iter()
+        .map(|o| match &o.object {
+            Object::Mesh(m) => m.clone(),
+            _ => panic!("a mesh"),
+        })
+        .collect();
+    assert_eq!(meshes.iter().map(|m| m.len()).collect::<Vec<_>>(), vec![2, 1, 2, 128, 2]);
+    // The PLY file is read once and placed by the transform; the inline mesh keeps its uvs.
+    assert!(meshes[0].positions().iter().all(|p| p.z == 2.0) && meshes[0].positions()[2] == Vec3::new(1.0, 1.0, 2.0));
+    assert_eq!(meshes[1].uvs().map(<[Vec2]>::len), Some(3));
+    // A flat bilinear patch is exact; the disk's tessellation is reported; its area is pi r^2 to 0.1 %.
+    assert!(!s.warnings.iter().any(|w| w.contains("bilinear")), "{:?}", s.warnings);
+    assert!(s.warnings.iter().any(|w| w.contains("approximated: Shape \"disk\"")), "{:?}", s.warnings);
+    let area: f32 = (0..128).map(|t| meshes[3].triangle(t).double_area() / 2.0).sum();
+    assert!((area / (4.0 * std::f32::consts::PI) - 1.0).abs() < 1e-3, "{area}");
+    // A missing PLY file is an error at its name, saying where it was looked for.
+    let text = "WorldBegin\nShape \"plymesh\" \"string filename\" \"gone.ply\"\n";
+    std::fs::write(&main, text).unwrap();
+    let e = load(&main, false).unwrap_err();
+    assert!(matches!(e, SceneError::Mesh { .. }));
+    let e = e.to_string();
+    assert!(
+        e.starts_with(&format!(
+            "{}: cannot load the mesh \"gone.ply\"",
+            place(&main.display().to_string(), text, "\"string filename\"")
+        )),
+        "{e}"
+    );
+}
+
+#[test]
 fn include_errors_name_the_file_line_and_column() {
     let dir = tempfile::tempdir().unwrap();
     let main = dir.path().join("main.pbrt");

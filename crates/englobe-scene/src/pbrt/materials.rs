@@ -192,8 +192,10 @@ impl Builder {
     /// `interface` (a boundary of media only: its shapes are not drawn). Reports what is
     /// approximated, naming `what` (the material) at `at`.
     pub fn classic_material(&mut self, at: Place, kind: &str, params: &Params, what: &str) -> Res<Option<Material>> {
+        // Keyed by the message, which holds the material's values: two materials approximated
+        // alike are one report, two different ones two.
         let approx = |b: &mut Builder, key: &str, message: String| {
-            b.report.approximated(at, &format!("{key} {what}"), || message)
+            b.report.approximated(at, &format!("{key} {message}"), || message)
         };
         let m = match kind {
             "diffuse" => {
