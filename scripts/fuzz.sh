@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Coverage-guided fuzzing of the scene parser, each mesh loader, the environment map decoder and the
-# tile reader with cargo fuzz
+# Coverage-guided fuzzing of the scene parsers (TOML, pbrt), each mesh loader, the MTL reader, the
+# texture and environment map decoders and the tile reader with cargo fuzz
 # (libFuzzer).
 #
 #   scripts/fuzz.sh [SECONDS_PER_TARGET] [TARGET...]
@@ -15,7 +15,7 @@ cd "$(dirname "$0")/.."
 seconds=${1:-60}
 shift || true
 targets=("$@")
-[ ${#targets[@]} -gt 0 ] || targets=(scene_toml mesh_obj mesh_ply mesh_gltf environment_map tile_exr mtl_text texture_image)
+[ ${#targets[@]} -gt 0 ] || targets=(scene_toml pbrt_scene mesh_obj mesh_ply mesh_gltf environment_map tile_exr mtl_text texture_image)
 shared=${ENGLOBE_SHARED:-../shared}
 
 seed() {
@@ -23,6 +23,7 @@ seed() {
     mkdir -p "$dir"
     case $target in
         scene_toml) find scenes -name '*.toml' -exec cp {} "$dir/" \; ;;
+        pbrt_scene) find "$shared/scenes" -name '*.pbrt' -size -2M -exec cp {} "$dir/" \; ;;
         mesh_obj) find "$shared/scenes/meshes" -name '*.obj' -size -200k -exec cp {} "$dir/" \; ;;
         mesh_ply) find "$shared/scenes/meshes" -name '*.ply' -size -2M -exec cp {} "$dir/" \; ;;
         mesh_gltf) find "$shared/scenes/meshes" \( -name '*.gltf' -o -name '*.glb' \) -size -2M -exec cp {} "$dir/" \; ;;

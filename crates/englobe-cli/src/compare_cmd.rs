@@ -67,7 +67,7 @@ pub struct CompareArgs {
 }
 
 pub fn run(args: CompareArgs) -> anyhow::Result<ExitCode> {
-    let (scene, scene_name) = read_scene(args.scene.as_ref(), &args.set)?;
+    let (scene, scene_name) = read_scene(args.scene.as_ref(), &args.set, false)?;
     let (width, height) = image_size(&scene.image, args.width, args.height, args.scale);
     let options = CompareOptions {
         width: Some(width),

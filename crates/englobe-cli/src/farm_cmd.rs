@@ -173,7 +173,7 @@ fn run_slurm(args: SlurmArgs) -> anyhow::Result<ExitCode> {
     if args.scene.as_ref().is_some_and(|p| p.as_os_str() == "-") {
         bail!("the farm's tasks read the scene from a file: give its path, not `-`");
     }
-    let (mut scene, _) = read_scene(args.scene.as_ref(), &args.image.overrides())?;
+    let (mut scene, _) = read_scene(args.scene.as_ref(), &args.image.overrides(), false)?;
     args.image.apply(&mut scene)?;
     let (width, height) = (scene.image.width, scene.image.height);
     TileSpec { index: 0, count: args.tiles }.window(width, height).map_err(anyhow::Error::msg)?;

@@ -14,13 +14,19 @@ use englobe_scene::{Material, MaterialModel, Scene, Texture, load_scene};
 
 #[derive(Args)]
 pub struct InfoArgs {
-    /// A mesh file (.obj, .ply, .gltf, .glb) or a scene file (.toml).
+    /// A mesh file (.obj, .ply, .gltf, .glb) or a scene file (.toml, or pbrt-v4 .pbrt).
     file: PathBuf,
+    /// For a pbrt scene: refuse it, at the first thing englobe would skip or approximate, instead
+    /// of listing those as warnings.
+    #[arg(long)]
+    strict: bool,
 }
 
 pub fn run(args: InfoArgs) -> anyhow::Result<ExitCode> {
     let is_scene = args.file.extension().is_some_and(|e| e.eq_ignore_ascii_case("toml"));
-    let text = if is_scene {
+    let text = if englobe_scene::pbrt::is_pbrt_path(&args.file) {
+        scene_info(&args.file, &englobe_scene::pbrt::load(&args.file, args.strict)?)
+    } else if is_scene {
         scene_info(&args.file, &load_scene(&args.file)?)
     } else {
         // The file as it is: no normals generated (its vertex count stays the file's).
@@ -200,6 +206,23 @@ pub fn scene_info(path: &Path, scene: &Scene) -> String {
         out,
         "image:      {}x{}, {} spp, depth {}",
         scene.image.width, scene.image.height, scene.image.samples, scene.image.max_depth
+    );
+    let _ = writeln!(
+        out,
+        "integrator: {}, filter {} of radius {}",
+        scene.image.integrator.name(),
+        scene.image.filter.name(),
+        scene.image.filter.radius()
+    );
+    let c = &scene.camera;
+    let _ = writeln!(
+        out,
+        "camera:     at {} looking at {}, up {}, vertical fov {}{}",
+        c.position,
+        c.look_at,
+        c.up,
+        c.fov_degrees,
+        if c.left_handed { " (left-handed, as pbrt)" } else { "" }
     );
     let _ = writeln!(out, "lights:     {}", scene.lights.len());
     let _ = writeln!(out, "objects:    {}", scene.objects.len());

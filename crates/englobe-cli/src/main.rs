@@ -50,8 +50,8 @@ enum Command {
     /// cargo feature, Embree the `embree` one; otherwise run the englobe-bench binary); prints a
     /// table per scene and thread count, writes a CSV and prints its path last.
     Bench(bench_cmd::BenchArgs),
-    /// Say what a mesh file (.obj, .ply, .gltf, .glb) or a scene file (.toml) holds, or why it is
-    /// refused.
+    /// Say what a mesh file (.obj, .ply, .gltf, .glb) or a scene file (.toml, .pbrt) holds, or why
+    /// it is refused.
     Info(info_cmd::InfoArgs),
 }
 

@@ -22,8 +22,8 @@ use crate::progress::{Phases, progress_bar, tile_bar};
 
 #[derive(Args, Clone)]
 pub struct RenderArgs {
-    /// Scene file (TOML, see docs/scene-format.md), `-` for standard input, or a mesh file (.obj,
-    /// .ply, .gltf, .glb) to see it framed (camera, ground, lights: the scene `englobe scene MESH`
+    /// Scene file (TOML, see docs/scene-format.md, or pbrt-v4 .pbrt, see docs/pbrt.md), `-` for
+    /// standard input, or a mesh file (.obj, .ply, .gltf, .glb) to see it framed (camera, ground, lights: the scene `englobe scene MESH`
     /// prints); the embedded default scene if omitted.
     scene: Option<PathBuf>,
     /// Output image (.png or .exr); defaults to the scene's name with .png, in the current folder
@@ -81,6 +81,10 @@ pub struct RenderArgs {
     /// No progress bar and no summary line.
     #[arg(short, long)]
     quiet: bool,
+    /// For a pbrt scene: refuse it, at the first thing englobe would skip or approximate, instead
+    /// of rendering it with warnings.
+    #[arg(long)]
+    strict: bool,
 }
 
 /// What `englobe render` writes.
@@ -102,10 +106,14 @@ pub enum CostScale {
 }
 
 /// The scene of the command line (`-` reads it from standard input, a mesh file is framed, see
-/// `englobe_scene::framing`), or the embedded default, with `overrides` applied, and its display
-/// name.
-pub fn read_scene(path: Option<&PathBuf>, overrides: &[Override]) -> anyhow::Result<(Scene, String)> {
+/// `englobe_scene::framing`, a `.pbrt` file is read as a pbrt-v4 scene, `strict` or not), or the
+/// embedded default, with `overrides` applied (refused for pbrt scenes), and its display name.
+pub fn read_scene(path: Option<&PathBuf>, overrides: &[Override], strict: bool) -> anyhow::Result<(Scene, String)> {
     match path {
+        Some(p) if englobe_scene::pbrt::is_pbrt_path(p) => {
+            englobe_scene::pbrt::refuse_overrides(overrides)?;
+            Ok((englobe_scene::pbrt::load(p, strict)?, p.display().to_string()))
+        }
         Some(p) if MeshFormat::from_path(p).is_some() => {
             let text = framing_scene(p)?;
             // Named without a folder, so that the mesh path in the text, as given, is read from
@@ -146,8 +154,12 @@ fn read_stdin() -> anyhow::Result<String> {
 pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
     let interrupted = interrupt::install()?;
     let Some(frames) = args.turntable else { return render(&args, interrupted) };
+    anyhow::ensure!(
+        !args.scene.as_ref().is_some_and(|p| englobe_scene::pbrt::is_pbrt_path(p)),
+        "--turntable moves the camera through a scene override (-D camera.position), which pbrt scenes do not take"
+    );
     // The camera of the scene as it will be rendered, then one render per frame with its position.
-    let (scene, _) = read_scene(args.scene.as_ref(), &args.image.overrides())?;
+    let (scene, _) = read_scene(args.scene.as_ref(), &args.image.overrides(), args.strict)?;
     let (position, look_at) = (scene.camera.position, scene.camera.look_at);
     let output = args.output.clone().unwrap_or_else(|| PathBuf::from(format!("{}.png", scene_stem(&args))));
     let stem = output.with_extension("");
@@ -209,7 +221,7 @@ fn render(args: &RenderArgs, interrupted: &'static std::sync::atomic::AtomicBool
     let phases = Phases::new(args.quiet);
     let shown_name = args.scene.as_ref().map_or("the default scene".into(), |p| p.display().to_string());
     let phase = phases.begin(&format!("loading {shown_name}"));
-    let (mut scene, scene_name) = read_scene(args.scene.as_ref(), &args.image.overrides())?;
+    let (mut scene, scene_name) = read_scene(args.scene.as_ref(), &args.image.overrides(), args.strict)?;
     let load_seconds = phases.end(phase, |s| {
         let triangles: usize = scene.objects.iter().map(|o| o.object.triangle_count()).sum();
         format!(

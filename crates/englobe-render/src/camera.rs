@@ -32,8 +32,15 @@ impl ImageCamera {
     /// non-degenerate camera (distinct look-at, up not parallel to the view).
     pub fn new(camera: &Camera, width: u32, height: u32) -> Self {
         let forward = (camera.look_at - camera.position).normalize();
-        let right_dir = forward.cross(camera.up).normalize();
-        let up_dir = right_dir.cross(forward);
+        // englobe's frame is right-handed (right = forward x up); pbrt's camera space is
+        // left-handed (right = up x forward), and its scenes say so through `left_handed`.
+        let (right_dir, up_dir) = if camera.left_handed {
+            let right = camera.up.cross(forward).normalize();
+            (right, forward.cross(right))
+        } else {
+            let right = forward.cross(camera.up).normalize();
+            (right, right.cross(forward))
+        };
         let (half_height, orthographic) = match camera.projection {
             Projection::Perspective => ((camera.fov_degrees.to_radians() * 0.5).tan(), false),
             Projection::Orthographic { view_height } => (view_height * 0.5, true),
@@ -126,6 +133,16 @@ mod tests {
         // Looking along +z with +y up, a right-handed frame puts the image's right at -x.
         let r = cam().ray(200.0, 50.0);
         assert!((r.dir() - Vec3::new(-2.0, 0.0, 1.0).normalize()).length() < 1e-6);
+    }
+
+    #[test]
+    fn a_left_handed_camera_mirrors_the_right_handed_one() {
+        let mut c = Camera::pinhole(Vec3::ZERO, Vec3::Z, Vec3::Y, 90.0);
+        c.left_handed = true;
+        let cam = ImageCamera::new(&c, 200, 100);
+        // Looking along +z with +y up, the left-handed frame puts the image's right at +x.
+        assert!((cam.ray(200.0, 50.0).dir() - Vec3::new(2.0, 0.0, 1.0).normalize()).length() < 1e-6);
+        assert!((cam.ray(100.0, 0.0).dir() - Vec3::new(0.0, 1.0, 1.0).normalize()).length() < 1e-6);
     }
 
     #[test]

@@ -2,6 +2,9 @@
 //! textures, every object with every vertex of its meshes) and the options of the render. Tiles record it,
 //! so that assembly can refuse pieces of different renders (see [`crate::tile`]).
 //!
+//! The scene's image settings include its pixel filter and its camera the camera's handedness,
+//! so both enter the digest with the rest.
+//!
 //! The hash is BLAKE3 (O'Connor, Aumasson, Neves and Wilcox-O'Hearn, 2020): fast enough that
 //! hashing a mesh costs less than loading it. Meshes are hashed by their numbers' bits, shared
 //! meshes once per instance reference; the small parts of the scene by their `Debug` text, which
@@ -141,6 +144,12 @@ mod tests {
         s.image.output.tonemap = englobe_scene::ToneMap::Filmic;
         s.image.output.exr_half = true;
         assert_eq!(base, scene_digest(&s, "accel=bvh-wide"), "how the image is written changes no pixel");
+        let mut s = scene();
+        s.image.filter = englobe_scene::PixelFilter::Triangle { radius: englobe::Vec2::splat(1.0) };
+        assert_ne!(base, scene_digest(&s, "accel=bvh-wide"), "the pixel filter changes the pixels");
+        let mut s = scene();
+        s.camera.left_handed = true;
+        assert_ne!(base, scene_digest(&s, "accel=bvh-wide"), "a mirrored camera changes the pixels");
         let mut s = scene();
         s.warnings.push("a warning changes nothing in the picture".into());
         assert_eq!(base, scene_digest(&s, "accel=bvh-wide"));

@@ -21,6 +21,7 @@ use rayon::prelude::*;
 use crate::camera::ImageCamera;
 use crate::cost::CostImage;
 use crate::film::Film;
+use crate::filter::FilterSampler;
 use crate::path::PathTracer;
 use crate::stats::{RenderStats, Tally};
 use crate::supersample::AdaptiveSupersampling;
@@ -77,6 +78,7 @@ pub struct Renderer<'a> {
     pub(crate) cancel: Option<&'a AtomicBool>,
     pub(crate) integrator: IntegratorKind,
     pub(crate) supersampling: Option<AdaptiveSupersampling>,
+    pub(crate) filter: FilterSampler,
 }
 
 impl<'a> Renderer<'a> {
@@ -98,6 +100,7 @@ impl<'a> Renderer<'a> {
             cancel: None,
             integrator: scene.image.integrator,
             supersampling: None,
+            filter: FilterSampler::new(&scene.image.filter),
         }
     }
 
@@ -300,9 +303,10 @@ impl<'a> Renderer<'a> {
     }
 
     /// The next sample of pixel `(x, y)`, whose generator is `rng`: through the pixel's centre
-    /// when the render takes one sample per pixel (as the seed's renderer did), jittered over the
-    /// pixel otherwise. A render by passes calls it in the same order per pixel, so the sums are
-    /// the same.
+    /// when the render takes one sample per pixel (as the seed's renderer did, whatever the
+    /// filter), otherwise at an offset drawn from the scene's pixel filter (see
+    /// [`crate::filter`]; the default box jitters over the pixel). A render by passes calls it in
+    /// the same order per pixel, so the sums are the same.
     #[inline]
     pub(crate) fn sample<C: Counters>(
         &self,
@@ -313,11 +317,13 @@ impl<'a> Renderer<'a> {
         rng: &mut Pcg32,
         tally: &mut Tally<C>,
     ) -> Vec3 {
-        let (dx, dy): (f32, f32) = if self.samples == 1 { (0.5, 0.5) } else { (rng.random(), rng.random()) };
+        let (dx, dy): (f32, f32) =
+            if self.samples == 1 { (0.5, 0.5) } else { self.filter.sample(rng.random(), rng.random()) };
         self.sample_at(camera, integrator, x, y, dx, dy, rng, tally)
     }
 
-    /// The sample of pixel `(x, y)` through its point `(dx, dy)` (both in `0..=1`).
+    /// The sample of pixel `(x, y)` through its point `(dx, dy)`, in pixels from its top-left
+    /// corner (`0..=1` inside the pixel; a filter wider than the pixel reaches beyond).
     #[inline]
     #[allow(clippy::too_many_arguments)]
     fn sample_at<C: Counters>(

@@ -69,6 +69,17 @@ pub struct ImageDef {
     #[serde(default)]
     pub exr_half: bool,
     pub clamp: Option<Positive>,
+    pub filter: Option<Spanned<String>>,
+    pub filter_radius: Option<Spanned<FilterRadius>>,
+    pub filter_sigma: Option<Spanned<Positive>>,
+}
+
+/// A filter radius: one number for both axes, or `[x, y]`.
+#[derive(Clone, Copy, Debug, Deserialize)]
+#[serde(untagged)]
+pub enum FilterRadius {
+    One(f64),
+    Two([f64; 2]),
 }
 
 #[derive(Debug, Deserialize)]

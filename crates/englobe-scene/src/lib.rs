@@ -2,7 +2,7 @@
 //!
 //! englobe's scene files: a small TOML format (documented key by key in `docs/scene-format.md`)
 //! read into a validated [`Scene`], and the mesh files scenes name ([`mesh`]: OBJ + MTL, PLY,
-//! glTF 2.0). A bad file is refused with an error that names the file, the line (or byte) and
+//! glTF 2.0), and pbrt-v4 scenes ([`pbrt`]). A bad file is refused with an error that names the file, the line (or byte) and
 //! says what was expected; nothing here panics on user input.
 
 pub mod environment;
@@ -19,6 +19,8 @@ pub mod parse;
 mod parse_environment;
 mod parse_material;
 mod parse_mesh;
+pub mod pbrt;
+pub mod pixel_filter;
 pub mod random_triangles;
 pub mod shared_data;
 pub mod texture;
@@ -37,5 +39,6 @@ pub use model::{
 pub use overrides::Override;
 pub use parse::{DEFAULT_MATERIAL, load_scene, load_scene_with, parse_scene, parse_scene_with};
 pub use parse_mesh::MAX_MESH_INSTANCES;
+pub use pixel_filter::PixelFilter;
 pub use random_triangles::MAX_RANDOM_TRIANGLES;
 pub use texture::{ColorSpace, Sampler, Texture, TextureId, Wrap};

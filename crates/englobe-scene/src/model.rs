@@ -10,12 +10,16 @@ use glam::Vec4;
 pub use crate::material::Material;
 use crate::texture::Texture;
 
+/// Name of the material objects get when they name none.
+pub const DEFAULT_MATERIAL: &str = "default";
+
 /// Largest image, in pixels (2^28: a 16384 x 16384 image), refused before anything is allocated.
 pub const MAX_PIXELS: u64 = 1 << 28;
 /// Most samples per pixel.
 pub const MAX_SAMPLES: u32 = 1 << 16;
-/// Deepest recursion of secondary rays.
-pub const MAX_DEPTH: u32 = 64;
+/// Deepest recursion of secondary rays (pbrt scenes ask for up to 65 and more; Russian roulette
+/// ends most paths well before).
+pub const MAX_DEPTH: u32 = 128;
 
 /// Image and integrator settings.
 #[derive(Clone, Debug, PartialEq)]
@@ -40,6 +44,9 @@ pub struct ImageSettings {
     pub seed: u64,
     /// How light is computed.
     pub integrator: IntegratorKind,
+    /// Which samples a pixel averages (with more than one sample per pixel): the box of radius
+    /// 0.5 by default, samples uniform over the pixel.
+    pub filter: crate::pixel_filter::PixelFilter,
     /// Largest component a sample's radiance may have (against fireflies): a sample above it is
     /// scaled down to it, keeping its hue; `None` (the default) leaves samples as they are.
     /// It changes the pixels, so tiles' digests cover it.
@@ -142,6 +149,9 @@ pub struct Camera {
     pub lens_radius: f32,
     /// Distance along the view direction of the plane in focus (positive).
     pub focus_distance: f32,
+    /// The image's right is `up x forward` (pbrt's camera space, left-handed) instead of
+    /// englobe's `forward x up`: set by the pbrt loader, so that pbrt scenes are not mirrored.
+    pub left_handed: bool,
 }
 
 impl Camera {
@@ -155,6 +165,7 @@ impl Camera {
             projection: Projection::Perspective,
             lens_radius: 0.0,
             focus_distance: (look_at - position).length(),
+            left_handed: false,
         }
     }
 }

@@ -5,18 +5,18 @@
 use std::ops::Range;
 use std::path::Path;
 
-use englobe::{AaBox, Object, Plane, Sphere, Triangle, Vec3};
+use englobe::{AaBox, Object, Plane, Sphere, Triangle, Vec2, Vec3};
 use serde::Deserialize;
 use toml::Spanned;
 use toml::de::DeTable;
 
 use crate::error::{Located, SceneError};
-use crate::format::{CameraDef, ImageDef, ProjectionKind, SceneFile};
+use crate::format::{CameraDef, FilterRadius, ImageDef, ProjectionKind, SceneFile};
 use crate::model::{Camera, ImageSettings, Light, MaterialId, Projection, Scene, SceneObject};
 use crate::overrides::{Override, Placed};
+use crate::pixel_filter::{MAX_FILTER_RADIUS, PixelFilter};
 
-/// Name of the material objects get when they name none.
-pub const DEFAULT_MATERIAL: &str = "default";
+pub use crate::model::DEFAULT_MATERIAL;
 /// Most spheres one `[[sphere_grid]]` may generate.
 pub const MAX_GRID_SPHERES: u64 = 1 << 24;
 /// Largest scene file read.
@@ -29,7 +29,14 @@ pub fn load_scene(path: &Path) -> Result<Scene, SceneError> {
 
 /// Reads the scene file at `path`, applies `overrides` (see [`crate::overrides`]) and validates
 /// the result.
+///
+/// A `.pbrt` file is read by [`crate::pbrt::load`] (not strict); overrides do not apply to it, so
+/// any is refused.
 pub fn load_scene_with(path: &Path, overrides: &[Override]) -> Result<Scene, SceneError> {
+    if crate::pbrt::is_pbrt_path(path) {
+        crate::pbrt::refuse_overrides(overrides)?;
+        return crate::pbrt::load(path, false);
+    }
     let meta = std::fs::metadata(path).map_err(|e| SceneError::io(path, e))?;
     if meta.is_dir() {
         return Err(SceneError::io(path, std::io::Error::other("is a directory, expected a scene file")));
@@ -207,6 +214,7 @@ impl Converter<'_> {
     fn image(&self, image: Spanned<ImageDef>) -> Result<ImageSettings, SceneError> {
         let span = image.span();
         let i = image.into_inner();
+        let filter = self.filter(&i, span.clone())?;
         let (width, height) = (*i.width.get_ref(), *i.height.get_ref());
         ImageSettings::check_limits(width, height, i.samples, i.max_depth).map_err(|message| {
             let at = if width == 0 || width as u64 * height as u64 > crate::model::MAX_PIXELS {
@@ -244,7 +252,41 @@ impl Converter<'_> {
             integrator: i.integrator,
             clamp: i.clamp.map(|c| c.0),
             output: crate::model::OutputSettings { exposure, tonemap: i.tonemap, exr_half: i.exr_half },
+            filter,
         })
+    }
+
+    /// `filter`, `filter_radius` and `filter_sigma` (see [`PixelFilter`]).
+    fn filter(&self, i: &ImageDef, image: Range<usize>) -> Result<PixelFilter, SceneError> {
+        let radius = match &i.filter_radius {
+            None => None,
+            Some(r) => {
+                let (x, y) = match *r.get_ref() {
+                    FilterRadius::One(v) => (v, v),
+                    FilterRadius::Two([x, y]) => (x, y),
+                };
+                if !(x > 0.0 && y > 0.0 && x <= MAX_FILTER_RADIUS as f64 && y <= MAX_FILTER_RADIUS as f64) {
+                    return Err(self.err(
+                        r.span(),
+                        format!("a filter radius must be more than 0 and at most {MAX_FILTER_RADIUS} pixels"),
+                    ));
+                }
+                Some((Vec2::new(x as f32, y as f32), r.span()))
+            }
+        };
+        let name = i.filter.as_ref().map_or("box", |n| n.get_ref().as_str());
+        let Some(filter) =
+            PixelFilter::named(name, radius.as_ref().map(|r| r.0), i.filter_sigma.as_ref().map(|s| s.get_ref().0))
+        else {
+            let at = i.filter.as_ref().map_or(image, |n| n.span());
+            return Err(
+                self.err(at, format!("unknown filter `{name}`: expected \"box\", \"triangle\" or \"gaussian\""))
+            );
+        };
+        if let (Some(s), false) = (&i.filter_sigma, matches!(filter, PixelFilter::Gaussian { .. })) {
+            return Err(self.err(s.span(), "`filter_sigma` is for `filter = \"gaussian\"`"));
+        }
+        Ok(filter)
     }
 
     fn camera(&self, camera: Spanned<CameraDef>) -> Result<Camera, SceneError> {
@@ -298,6 +340,7 @@ impl Converter<'_> {
             projection,
             lens_radius: c.aperture.map_or(0.0, |a| a.0 * 0.5),
             focus_distance: c.focus_distance.map_or(distance, |f| f.0),
+            left_handed: false,
         })
     }
 }

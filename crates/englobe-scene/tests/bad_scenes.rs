@@ -136,6 +136,29 @@ fn image_limits() {
 }
 
 #[test]
+fn pixel_filters_are_checked() {
+    check("width = 64", "width = 64\nfilter = \"mitchell\"", "\"mitchell\"", "unknown filter `mitchell`");
+    check("width = 64", "width = 64\nfilter = \"box\"\nfilter_sigma = 0.5", "0.5", "`filter_sigma` is for");
+    check("width = 64", "width = 64\nfilter = \"triangle\"\nfilter_radius = 0", "0", "more than 0");
+    check("width = 64", "width = 64\nfilter_radius = [1, 17]", "[1, 17]", "at most 16");
+    check("width = 64", "width = 64\nfilter = \"gaussian\"\nfilter_sigma = -1", "-1", "greater than 0");
+    let filter = |keys: &str| {
+        parse_scene(&GOOD.replacen("width = 64", &format!("width = 64\n{keys}"), 1), "f.toml".as_ref())
+            .unwrap()
+            .image
+            .filter
+    };
+    use englobe::Vec2;
+    use englobe_scene::PixelFilter;
+    assert_eq!(filter(""), PixelFilter::Box { radius: Vec2::splat(0.5) });
+    assert_eq!(filter("filter = \"triangle\""), PixelFilter::Triangle { radius: Vec2::splat(2.0) });
+    assert_eq!(
+        filter("filter = \"gaussian\"\nfilter_radius = [2, 1]\nfilter_sigma = 0.25"),
+        PixelFilter::Gaussian { radius: Vec2::new(2.0, 1.0), sigma: 0.25 }
+    );
+}
+
+#[test]
 fn other_checked_values() {
     check("[[sphere]]", "[[plane]]\npoint = [0,0,0]\nnormal = [0,0,0]\n[[sphere]]", "[0,0,0]\n[[", "non-zero normal");
     check("[[sphere]]", "[[box]]\nmin = [0,0,0]\nmax = [1,0,1]\n[[sphere]]", "[[box]]", "min < max");
