@@ -148,12 +148,33 @@ pub(crate) mod tests {
         let mut cut = png(4, 4, &[[7; 4]; 16]);
         cut.truncate(cut.len() / 2);
         assert!(decode_image(&cut).is_err());
-        // A PNG header claiming 2^30 x 2^30 texels is refused before decoding.
+        // A valid PNG header (its checksum made right) claiming 2^14 x 2^14 texels, within each
+        // side's limit but over the texel limit, is refused before a texel is decoded.
         let mut huge = png(1, 1, &[[0; 4]]);
-        huge[16..20].copy_from_slice(&(1u32 << 30).to_be_bytes());
-        huge[20..24].copy_from_slice(&(1u32 << 30).to_be_bytes());
+        huge[16..20].copy_from_slice(&(1u32 << 14).to_be_bytes());
+        huge[20..24].copy_from_slice(&(1u32 << 14).to_be_bytes());
+        let crc = crc32(&huge[12..29]);
+        huge[29..33].copy_from_slice(&crc.to_be_bytes());
         let e = decode_image(&huge).unwrap_err();
-        assert!(!e.is_empty());
+        assert!(e.contains("16384x16384") && e.contains("over the limit"), "{e}");
+        // Wider than a side may be: refused by the decoder's own limits.
+        huge[16..20].copy_from_slice(&(1u32 << 20).to_be_bytes());
+        huge[20..24].copy_from_slice(&1u32.to_be_bytes());
+        let crc = crc32(&huge[12..29]);
+        huge[29..33].copy_from_slice(&crc.to_be_bytes());
+        assert!(decode_image(&huge).is_err());
+    }
+
+    /// The CRC-32 of PNG chunks (ISO 3309, as the PNG specification's annex D computes it).
+    fn crc32(bytes: &[u8]) -> u32 {
+        let mut c = 0xffff_ffffu32;
+        for &b in bytes {
+            c ^= b as u32;
+            for _ in 0..8 {
+                c = if c & 1 != 0 { 0xedb8_8320 ^ (c >> 1) } else { c >> 1 };
+            }
+        }
+        !c
     }
 
     #[test]
