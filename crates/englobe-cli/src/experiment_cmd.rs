@@ -19,8 +19,9 @@ pub enum Experiment {
     Seed,
     /// Fewer rays: adaptive depth at several thresholds against full depth, and adaptive
     /// supersampling against uniform supersampling, on the seed's scenes, the glass, mirrors and
-    /// Sponza scenes (or the SCENEs given): rays per kind, exact tests, time, and the image's
-    /// difference (RMSE, SSIM).
+    /// Sponza scenes; adaptive sampling against uniform sampling on the path-traced Cornell box
+    /// (or the SCENEs given): rays per kind, exact tests, time, the image's difference (RMSE,
+    /// SSIM), and the samples uniform sampling needs for adaptive sampling's error.
     FewerRays,
 }
 
@@ -35,6 +36,17 @@ pub struct ExperimentArgs {
     /// fewer-rays: the adaptive-depth thresholds, comma-separated (default 0.1,0.03,0.01,0.003).
     #[arg(long, value_delimiter = ',')]
     thresholds: Vec<f32>,
+    /// fewer-rays: the noise thresholds of adaptive sampling on path-traced scenes,
+    /// comma-separated (default 0.1,0.05,0.02,0.01).
+    #[arg(long, value_delimiter = ',')]
+    noise_thresholds: Vec<f32>,
+    /// fewer-rays: the longer side of path-traced scenes' images (default 128).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=16384))]
+    path_size: Option<u32>,
+    /// fewer-rays: samples per pixel of path-traced scenes' reference, and adaptive sampling's
+    /// maximum (default 1024; the uniform renders take 16, 32, ... up to half of it).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(32..=65536))]
+    reference_spp: Option<u32>,
     /// Image width and height in pixels (default: the scenes' own, 512, like the report's); for
     /// fewer-rays, the longer side (default 320).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
@@ -64,7 +76,14 @@ pub fn run(args: ExperimentArgs) -> anyhow::Result<ExitCode> {
     if args.experiment == Experiment::FewerRays {
         return fewer_rays(args);
     }
-    anyhow::ensure!(args.scenes.is_empty() && args.thresholds.is_empty(), "scenes and --thresholds are for fewer-rays");
+    anyhow::ensure!(
+        args.scenes.is_empty()
+            && args.thresholds.is_empty()
+            && args.noise_thresholds.is_empty()
+            && args.path_size.is_none()
+            && args.reference_spp.is_none(),
+        "scenes, --thresholds, --noise-thresholds, --path-size and --reference-spp are for fewer-rays"
+    );
     let options = SeedOptions {
         size: args.size,
         tests: args.tests,
@@ -102,6 +121,15 @@ fn fewer_rays(args: ExperimentArgs) -> anyhow::Result<ExitCode> {
         anyhow::ensure!(args.thresholds.iter().all(|t| (0.0..=1.0).contains(t)), "--thresholds: each between 0 and 1");
         options.thresholds = args.thresholds;
     }
+    if !args.noise_thresholds.is_empty() {
+        anyhow::ensure!(
+            args.noise_thresholds.iter().all(|t| t.is_finite() && *t > 0.0),
+            "--noise-thresholds: each greater than 0"
+        );
+        options.noise_thresholds = args.noise_thresholds;
+    }
+    options.path_size = args.path_size.unwrap_or(options.path_size);
+    options.reference_samples = args.reference_spp.unwrap_or(options.reference_samples);
     let quiet = args.quiet;
     let experiment = run_fewer_rays(&options, &mut |line| {
         if !quiet {

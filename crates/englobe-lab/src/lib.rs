@@ -24,6 +24,7 @@
 pub mod compare;
 pub mod error;
 pub mod fewer_rays;
+pub mod fewer_samples;
 pub mod html_report;
 pub mod image_error;
 pub mod measure;

@@ -29,10 +29,12 @@
 //! image rendered with the blocks that cover it gets the pixels of the whole render.
 //!
 //! **The schedule**: a first pass of `min_samples` everywhere (the estimate is meaningless on a
-//! handful of samples, and rare bright paths need a chance to show), then passes that add half
-//! the samples taken so far (16, 24, 36, 54, 81, ...), up to `samples`. Geometric steps keep the
-//! number of looks at the estimate small (each look is a chance to stop on an unlucky low
-//! estimate) while stopping within 1.5 times the samples a block needed.
+//! handful of samples, and rare bright paths need a chance to show), then passes that add a
+//! quarter of the samples taken so far (16, 20, 25, 32, 40, 50, ...), up to `samples`. Geometric
+//! steps keep the number of looks at the estimate small (each look is a chance to stop on an
+//! unlucky low estimate: 19 passes from 16 to 1 024 samples) while a block stops within 1.25 times
+//! the samples it needed (1.12 times on average), which is most of what adaptive sampling saves
+//! where noise is even.
 
 use englobe::Vec3;
 use englobe_scene::ImageSettings;
@@ -74,9 +76,9 @@ impl AdaptiveSampling {
     }
 
     /// Samples per pixel after the pass that follows `taken` (0 before the first pass): the
-    /// minimum, then half as many again each pass, at most the maximum.
+    /// minimum, then a quarter more each pass, at most the maximum.
     pub fn next_total(&self, taken: u32) -> u32 {
-        if taken == 0 { self.min_samples } else { taken.saturating_add(taken.div_ceil(2)).min(self.max_samples) }
+        if taken == 0 { self.min_samples } else { taken.saturating_add(taken.div_ceil(4)).min(self.max_samples) }
     }
 
     /// Whether a block with this error (the mean of its pixels' errors) has converged. NaN (a
@@ -160,7 +162,7 @@ mod tests {
     }
 
     #[test]
-    fn passes_grow_by_half_up_to_the_maximum() {
+    fn passes_grow_by_a_quarter_up_to_the_maximum() {
         let a = AdaptiveSampling { threshold: 0.01, min_samples: 16, max_samples: 100 };
         let mut totals = vec![];
         let mut taken = 0;
@@ -168,9 +170,9 @@ mod tests {
             taken = a.next_total(taken);
             totals.push(taken);
         }
-        assert_eq!(totals, [16, 24, 36, 54, 81, 100]);
+        assert_eq!(totals, [16, 20, 25, 32, 40, 50, 63, 79, 99, 100]);
         let two = AdaptiveSampling { threshold: 0.01, min_samples: 2, max_samples: 5 };
-        assert_eq!((two.next_total(0), two.next_total(2), two.next_total(3), two.next_total(5)), (2, 3, 5, 5));
+        assert_eq!((two.next_total(0), two.next_total(2), two.next_total(4), two.next_total(5)), (2, 3, 5, 5));
     }
 
     #[test]
