@@ -6,8 +6,10 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
+use anyhow::Context;
 use clap::{Args, ValueEnum};
 use englobe::AccelKind;
+use englobe_lab::html_report::{render_seed_pictures, write_seed_report};
 use englobe_lab::{FewerRaysOptions, SeedOptions, run_fewer_rays, run_seed};
 
 use crate::image_options::parse_accel;
@@ -67,6 +69,11 @@ pub struct ExperimentArgs {
     /// Write every image rendered into this folder, as testN-ACCEL.png.
     #[arg(long, value_name = "DIR")]
     images: Option<PathBuf>,
+    /// seed: also write the experiment as one self-contained HTML page, DIR/index.html: the
+    /// report's claims checked, and for each test its table beside the report's figures, its plot,
+    /// the image and one cost heatmap per structure (no server, no network needed to open it).
+    #[arg(long, value_name = "DIR")]
+    report: Option<PathBuf>,
     /// No progress lines on standard error.
     #[arg(short, long)]
     quiet: bool,
@@ -75,6 +82,10 @@ pub struct ExperimentArgs {
 pub fn run(args: ExperimentArgs) -> anyhow::Result<ExitCode> {
     if args.experiment == Experiment::FewerRays {
         return fewer_rays(args);
+    }
+    if let Some(dir) = &args.report {
+        // Checked before the experiment runs, so that it never ends in "cannot write".
+        std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     }
     anyhow::ensure!(
         args.scenes.is_empty()
@@ -102,6 +113,14 @@ pub fn run(args: ExperimentArgs) -> anyhow::Result<ExitCode> {
     if let Some(path) = &args.json {
         experiment.write_json(path)?;
     }
+    if let Some(dir) = &args.report {
+        if !quiet {
+            eprintln!("rendering the pictures of the report...");
+        }
+        let pictures = render_seed_pictures(&experiment)?;
+        let page = write_seed_report(dir, &experiment, &pictures)?;
+        println!("wrote {}", page.display());
+    }
     if !experiment.images_identical() {
         eprintln!("error: some accelerators drew a different image than brute force (see the image column)");
         return Ok(ExitCode::from(2));
@@ -110,6 +129,7 @@ pub fn run(args: ExperimentArgs) -> anyhow::Result<ExitCode> {
 }
 
 fn fewer_rays(args: ExperimentArgs) -> anyhow::Result<ExitCode> {
+    anyhow::ensure!(args.report.is_none(), "--report is for the seed experiment");
     let mut options = FewerRaysOptions { threads: args.threads, ..FewerRaysOptions::default() };
     if !args.scenes.is_empty() {
         options.scenes = args.scenes;

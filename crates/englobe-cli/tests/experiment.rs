@@ -271,3 +271,21 @@ fn compare_writes_a_self_contained_report_page() {
     assert!(page.contains("<svg") && page.contains("<table id=\"quality\">"));
     assert!(std::fs::read_dir(&report).unwrap().count() == 1, "one file: the page holds everything");
 }
+
+#[test]
+fn the_seed_experiment_writes_its_page() {
+    let dir = tempfile::tempdir().unwrap();
+    let report = dir.path().join("seed-report");
+    let out = englobe()
+        .args(["experiment", "seed", "--size", "16", "--tests", "2", "--accel", "bvh-seed", "-q", "--report"])
+        .arg(&report)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let page = std::fs::read_to_string(report.join("index.html")).unwrap();
+    assert!(String::from_utf8_lossy(&out.stdout).contains("index.html"));
+    assert!(page.contains("<table id=\"table-2\">") && page.contains("<ul id=\"claims\">"));
+    assert_eq!(page.matches("<img ").count(), 3, "the image and the heatmaps of none and bvh-seed");
+    let refused = englobe().args(["experiment", "fewer-rays", "--report"]).arg(&report).output().unwrap();
+    assert!(String::from_utf8_lossy(&refused.stderr).contains("--report is for the seed experiment"));
+}

@@ -240,10 +240,11 @@ mod tests {
         let uniform: Vec<&SamplingRow> = rows.iter().filter(|r| r.method == "uniform").collect();
         assert_eq!(uniform.iter().map(|r| r.samples_mean).collect::<Vec<_>>(), [16.0, 32.0, 64.0, 128.0]);
         assert!(uniform.windows(2).all(|w| w[1].error.rmse < w[0].error.rmse), "more samples, less error");
+        eprintln!("{}", sampling_table(&rows));
         let adaptive = rows.last().unwrap();
         let ratio = adaptive.ratio.expect("its error lies within the uniform renders'");
         // The sky (a third of the image) stops at the first pass; the rest takes about what uniform
-        // sampling takes. The figures are fixed by the seed: 1.26 times fewer samples.
+        // sampling takes. The figures are fixed by the seed: 1.22 times fewer samples.
         assert!(ratio > 1.15, "{ratio}: {}", sampling_table(&rows));
         assert!(adaptive.samples_mean < adaptive.uniform_equivalent.unwrap());
         let table = sampling_table(&rows);

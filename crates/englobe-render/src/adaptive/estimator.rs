@@ -18,6 +18,14 @@
 //! difference is the idea of Rousselle, Knaus and Zwicker (2012, "Adaptive Rendering with
 //! Non-Local Means Filtering") as well: it needs no sample variance and holds for any integrator.
 //!
+//! One change to Cycles: the half-buffers hold the samples as the film shows them, each channel
+//! clamped to `0..=1` (see [`crate::film::Film::to_srgb8`]), while the image keeps the samples
+//! themselves. Where the film saturates, the noise of the linear values does not show: the outline
+//! of a lamp (samples of the emitter, dozens of times the display's white, beside samples of a
+//! dim ceiling) has a relative variance near one in linear values and would take every sample up
+//! to the maximum for a difference no one sees. If the film gains an exposure or a tone curve, the
+//! clamp should follow it.
+//!
 //! **Blocks, not pixels.** One pixel's `|A - B|` is a single draw of a noisy quantity: a pixel
 //! whose halves agree by chance would stop long before it is smooth (Cycles answers with a
 //! minimum of samples and by waking a stopped pixel's neighbours). englobe decides per block of
@@ -89,13 +97,16 @@ impl AdaptiveSampling {
 }
 
 /// What a pixel keeps of its samples: the sum of all of them, in the order they were taken (so
-/// that their mean is bit for bit a uniform render's), and the sum of the even-numbered ones.
+/// that their mean is bit for bit a uniform render's), and the two half-buffers of the estimate,
+/// as the film shows the samples (each channel clamped to `0..=1`).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct HalfSums {
-    /// Every sample added.
+    /// Every sample added, as it is.
     pub all: Vec3,
-    /// The samples of even number (the first, the third, ...): half-buffer `A`.
+    /// The samples of even number (the first, the third, ...), as shown: half-buffer `A`.
     pub even: Vec3,
+    /// The samples of odd number, as shown: half-buffer `B`.
+    pub odd: Vec3,
 }
 
 impl HalfSums {
@@ -103,8 +114,11 @@ impl HalfSums {
     #[inline]
     pub fn add(&mut self, index: u32, value: Vec3) {
         self.all += value;
+        let shown = value.clamp(Vec3::ZERO, Vec3::ONE);
         if index.is_multiple_of(2) {
-            self.even += value;
+            self.even += shown;
+        } else {
+            self.odd += shown;
         }
     }
 
@@ -117,11 +131,10 @@ impl HalfSums {
     pub fn error(&self, n: u32) -> f32 {
         debug_assert!(n >= 2, "two halves need two samples");
         let (n_a, n_b) = (n.div_ceil(2) as f32, (n / 2) as f32);
-        let a = self.even / n_a;
-        let b = (self.all - self.even) / n_b;
+        let (a, b) = (self.even / n_a, self.odd / n_b);
         let d = (a - b).abs();
         let difference = (d.x + d.y + d.z) * 0.5;
-        let mean = self.mean(n);
+        let mean = (self.even + self.odd) / n as f32;
         let intensity = mean.x + mean.y + mean.z;
         let normalise = if intensity < 1.0 { intensity.max(0.0).sqrt() } else { intensity };
         difference / (EPSILON + normalise)
@@ -184,15 +197,22 @@ mod tests {
         p.add(1, Vec3::splat(0.3));
         let expected = 0.3 / (1e-4 + 0.6f32.sqrt());
         assert!((p.error(2) - expected).abs() < 1e-6, "{}", p.error(2));
-        // Above 1 the division is by the intensity itself.
+        // Above 1 the division is by the intensity itself: samples 0.6 and 1.0 grey have a mean
+        // intensity of 2.4 and a difference of 3 * 0.4 / 2.
         let mut bright = HalfSums::default();
-        bright.add(0, Vec3::new(2.0, 0.0, 0.0));
-        bright.add(1, Vec3::new(4.0, 0.0, 0.0));
-        assert!((bright.error(2) - 1.0 / (1e-4 + 3.0)).abs() < 1e-6);
-        // Identical halves (but for the rounding of the sums), and black: no error.
+        bright.add(0, Vec3::splat(0.6));
+        bright.add(1, Vec3::splat(1.0));
+        assert!((bright.error(2) - 0.6 / (1e-4 + 2.4)).abs() < 1e-6, "{}", bright.error(2));
+        // The halves hold what the film shows: beyond white, no difference, whatever the image's
+        // values (which the mean keeps).
+        let mut lamp = HalfSums::default();
+        lamp.add(0, Vec3::splat(3.0));
+        lamp.add(1, Vec3::splat(40.0));
+        assert_eq!((lamp.error(2), lamp.mean(2)), (0.0, Vec3::splat(21.5)));
+        // Identical halves, and black: no error.
         let mut flat = HalfSums::default();
         (0..6).for_each(|i| flat.add(i, Vec3::splat(0.3)));
-        assert!(flat.error(6) < 1e-6, "{}", flat.error(6));
+        assert_eq!(flat.error(6), 0.0);
         assert_eq!(HalfSums::default().error(4), 0.0);
         assert!(!AdaptiveSampling { threshold: 1.0, min_samples: 2, max_samples: 2 }.converged(f32::NAN));
     }

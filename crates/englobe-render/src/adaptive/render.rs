@@ -10,7 +10,8 @@
 //! converges gives the uniform render's pixels. A window (a tile) is rendered with every block
 //! that touches it, whole, and keeps its own pixels: the same values as the whole image's.
 //!
-//! Memory: a generator, two sums and the work per pixel (48 bytes), as a render by passes.
+//! Memory: a generator, three sums and the work per pixel (60 bytes), a little more than a render
+//! by passes.
 
 use std::sync::atomic::Ordering;
 use std::time::Instant;
