@@ -11,8 +11,9 @@
 #
 # Needs root for apt-get when chromium is missing. Chromium runs with --no-sandbox, since CI runs
 # as root, where its sandbox refuses to start.
-# Usage: scripts/report-screenshot.sh [path/to/englobe] [screenshot.png]
-#        (default: target/debug/englobe, built if needed)
+# Usage: scripts/report-screenshot.sh [path/to/englobe] [screenshot.png] [compare options...]
+#        (default: target/debug/englobe, built if needed; options such as `--accel bvh-wide
+#        --width 160` make a quick check, the full comparison taking minutes)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -28,8 +29,9 @@ fi
 
 ENGLOBE=${1:-target/debug/englobe}
 SHOT=${2:-target/report/screenshot.png}
+shift $(( $# < 2 ? $# : 2 ))
 [ -x "$ENGLOBE" ] || cargo build -q -p englobe-cli
-"$ENGLOBE" compare scenes/sponza.toml --report target/report -q >/dev/null
+"$ENGLOBE" compare scenes/sponza.toml --report target/report -q "$@" >/dev/null
 PAGE=$(realpath target/report/index.html)
 mkdir -p "$(dirname "$SHOT")"
 SHOT=$(realpath -m "$SHOT")

@@ -39,14 +39,14 @@ pub struct ExperimentArgs {
     #[arg(long, value_delimiter = ',')]
     thresholds: Vec<f32>,
     /// fewer-rays: the noise thresholds of adaptive sampling on path-traced scenes,
-    /// comma-separated (default 0.1,0.05,0.02,0.01).
+    /// comma-separated (default 0.05,0.03,0.02,0.01).
     #[arg(long, value_delimiter = ',')]
     noise_thresholds: Vec<f32>,
     /// fewer-rays: the longer side of path-traced scenes' images (default 128).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=16384))]
     path_size: Option<u32>,
     /// fewer-rays: samples per pixel of path-traced scenes' reference, and adaptive sampling's
-    /// maximum (default 1024; the uniform renders take 16, 32, ... up to half of it).
+    /// maximum (default 4096; the uniform renders take 16, 32, ... up to a quarter of it).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(32..=65536))]
     reference_spp: Option<u32>,
     /// Image width and height in pixels (default: the scenes' own, 512, like the report's); for

@@ -28,11 +28,12 @@ fn fewer_samples_said_in_the_summary_the_statistics_and_the_map() {
     let o = ok(englobe(dir.path(), &args));
     let said = String::from_utf8_lossy(&o.stdout);
     assert!(said.contains("adaptive ") && said.contains(" spp of at most 64, threshold 0.05"), "{said}");
-    assert!(said.contains("per pixel on average (16 to "), "{said}");
+    // The first pass, as Cycles chooses it: 16 / 0.05^0.3 = 39.3.
+    assert!(said.contains("per pixel on average (40 to "), "{said}");
     let json: serde_json::Value = serde_json::from_slice(&std::fs::read(dir.path().join("s.json")).unwrap()).unwrap();
     let total = json["samples_total"].as_u64().unwrap();
     let mean = json["samples_mean"].as_f64().unwrap();
-    assert!(total < 48 * 36 * 64 && total >= 48 * 36 * 16, "{total}");
+    assert!(total < 48 * 36 * 64 && total >= 48 * 36 * 40, "{total}");
     assert!((mean - total as f64 / (48.0 * 36.0)).abs() < 1e-9);
     assert_eq!(json["noise_threshold"].as_f64().unwrap() as f32, 0.05);
     // Every sample is one primary ray.
@@ -102,6 +103,8 @@ fn a_time_limit_keeps_whole_adaptive_passes() {
             "65536",
             "--noise-threshold",
             "0.0001",
+            "-D",
+            "image.min_samples=4",
             "--time-limit",
             "1.5s",
             "-o",
@@ -124,7 +127,7 @@ fn a_samples_map_without_a_threshold_is_refused_before_rendering() {
     let e = String::from_utf8_lossy(&o.stderr);
     assert!(e.contains("m.png: every pixel takes 4 sample(s) without a noise threshold"), "{e}");
     assert!(!dir.path().join("x.png").exists() && !dir.path().join("m.png").exists());
-    let o = englobe(dir.path(), &["render", "--noise-threshold", "-1"]);
+    let o = englobe(dir.path(), &["render", "--noise-threshold=-1"]);
     assert!(String::from_utf8_lossy(&o.stderr).contains("expected a relative error of 0 or more"));
     // The scene key works through the generic override as well.
     let o = ok(englobe(

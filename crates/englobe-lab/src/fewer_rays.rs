@@ -69,8 +69,8 @@ pub struct FewerRaysOptions {
     pub thresholds: Vec<f32>,
     /// Worker threads (default: all cores).
     pub threads: Option<u32>,
-    /// The longer side of path-traced scenes' images (default 128: their reference takes a
-    /// thousand samples per pixel).
+    /// The longer side of path-traced scenes' images (default 128: their reference takes
+    /// thousands of samples per pixel).
     pub path_size: u32,
     /// Samples per pixel of path-traced scenes' reference (default [`REFERENCE_PATH_SAMPLES`]);
     /// also adaptive sampling's maximum.
@@ -215,6 +215,9 @@ impl FewerRays {
     /// The table: one line per render, the rays of each kind, exact tests, time, and the error.
     pub fn table(&self) -> String {
         let mut s = String::new();
+        if self.rows.is_empty() {
+            return sampling_table(&self.sampling).trim_start().to_owned();
+        }
         let _ = writeln!(
             s,
             "{:<24} {:<18} {:>8} {:>10} {:>10} {:>10} {:>10} {:>13} {:>7} {:>6} {:>7}",

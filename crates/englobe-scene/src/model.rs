@@ -32,8 +32,8 @@ pub struct ImageSettings {
     /// stops taking samples once its estimated relative error falls under this, and `samples` is
     /// the most a pixel takes; 0 (the default) takes `samples` everywhere.
     pub noise_threshold: f32,
-    /// Samples of adaptive sampling's first pass, before any block may stop (`None`: the larger
-    /// of 16 and `samples / 8`); at most `samples`.
+    /// Samples of adaptive sampling's first pass, before any block may stop (`None`: as Cycles
+    /// chooses them, `16 / noise_threshold^0.3`); at most `samples`.
     pub min_samples: Option<u32>,
     /// Colour of rays that hit nothing (linear RGB).
     pub background: Vec3,

@@ -50,9 +50,14 @@ use englobe_scene::ImageSettings;
 /// Side of the blocks that stop together, in pixels (the image's blocks start at its corner).
 pub const BLOCK_SIZE: u32 = 8;
 
-/// Samples of the first pass when the scene does not set `min_samples` (and `samples / 8` is
-/// less).
-pub const DEFAULT_MIN_SAMPLES: u32 = 16;
+/// Samples of the first pass when the scene does not set `min_samples`, as Cycles chooses them
+/// (`Integrator::get_adaptive_sampling`): `16 / threshold^0.3`, at least 4 (32 at 0.1, 64 at
+/// 0.01, 128 at 0.001), since a finer threshold needs a steadier first estimate; at most
+/// `samples`.
+pub fn default_min_samples(threshold: f32, samples: u32) -> u32 {
+    let cycles = (16.0 / threshold.powf(0.3)).ceil();
+    (if cycles.is_finite() { cycles.min(u32::MAX as f32) as u32 } else { u32::MAX }).max(4).min(samples)
+}
 
 /// Added to the error's divisor, as in Cycles, so that black pixels divide by no zero.
 const EPSILON: f32 = 1e-4;
@@ -75,7 +80,7 @@ impl AdaptiveSampling {
         if !(image.noise_threshold > 0.0) || samples < 2 {
             return None;
         }
-        let min = image.min_samples.unwrap_or((samples / 8).max(DEFAULT_MIN_SAMPLES));
+        let min = image.min_samples.unwrap_or_else(|| default_min_samples(image.noise_threshold, samples));
         Some(AdaptiveSampling {
             threshold: image.noise_threshold,
             min_samples: min.clamp(2, samples),
@@ -168,9 +173,12 @@ mod tests {
         assert_eq!(AdaptiveSampling::of(&settings(0.0, None), 64), None);
         assert_eq!(AdaptiveSampling::of(&settings(0.01, None), 1), None);
         let a = AdaptiveSampling::of(&settings(0.01, None), 1024).unwrap();
-        assert_eq!((a.min_samples, a.max_samples), (128, 1024), "samples / 8 above 16");
-        assert_eq!(AdaptiveSampling::of(&settings(0.01, None), 64).unwrap().min_samples, 16);
-        assert_eq!(AdaptiveSampling::of(&settings(0.01, None), 8).unwrap().min_samples, 8, "at most the maximum");
+        assert_eq!((a.min_samples, a.max_samples), (64, 1024), "16 / 0.01^0.3 = 63.7");
+        // Cycles' comment: 0.1 gives 32, 0.001 gives 128; 0.05 gives 16 / 0.407 = 39.3.
+        let min = |t: f32, samples: u32| AdaptiveSampling::of(&settings(t, None), samples).unwrap().min_samples;
+        assert_eq!((min(0.1, 4096), min(0.001, 4096), min(0.05, 4096)), (32, 128, 40));
+        assert_eq!((min(1000.0, 4096), min(1e-30, 65536)), (4, 65536), "at least 4, at most the maximum");
+        assert_eq!(min(0.01, 8), 8, "at most the maximum");
         assert_eq!(AdaptiveSampling::of(&settings(0.01, Some(4)), 64).unwrap().min_samples, 4);
     }
 

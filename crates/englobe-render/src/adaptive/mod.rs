@@ -8,5 +8,5 @@
 pub mod estimator;
 pub mod render;
 
-pub use estimator::{AdaptiveSampling, BLOCK_SIZE, HalfSums, block_error};
+pub use estimator::{AdaptiveSampling, BLOCK_SIZE, HalfSums, block_error, default_min_samples};
 pub use render::covering_blocks;
