@@ -6,8 +6,10 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
+use anyhow::Context;
 use clap::{Args, ValueEnum};
 use englobe::AccelKind;
+use englobe_lab::html_report::{render_seed_pictures, write_seed_report};
 use englobe_lab::{FewerRaysOptions, SeedOptions, run_fewer_rays, run_seed};
 
 use crate::image_options::parse_accel;
@@ -19,8 +21,9 @@ pub enum Experiment {
     Seed,
     /// Fewer rays: adaptive depth at several thresholds against full depth, and adaptive
     /// supersampling against uniform supersampling, on the seed's scenes, the glass, mirrors and
-    /// Sponza scenes (or the SCENEs given): rays per kind, exact tests, time, and the image's
-    /// difference (RMSE, SSIM).
+    /// Sponza scenes; adaptive sampling against uniform sampling on the path-traced Cornell box
+    /// (or the SCENEs given): rays per kind, exact tests, time, the image's difference (RMSE,
+    /// SSIM), and the samples uniform sampling needs for adaptive sampling's error.
     FewerRays,
 }
 
@@ -35,6 +38,17 @@ pub struct ExperimentArgs {
     /// fewer-rays: the adaptive-depth thresholds, comma-separated (default 0.1,0.03,0.01,0.003).
     #[arg(long, value_delimiter = ',')]
     thresholds: Vec<f32>,
+    /// fewer-rays: the noise thresholds of adaptive sampling on path-traced scenes,
+    /// comma-separated (default 0.05,0.03,0.02,0.01).
+    #[arg(long, value_delimiter = ',')]
+    noise_thresholds: Vec<f32>,
+    /// fewer-rays: the longer side of path-traced scenes' images (default 128).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=16384))]
+    path_size: Option<u32>,
+    /// fewer-rays: samples per pixel of path-traced scenes' reference, and adaptive sampling's
+    /// maximum (default 4096; the uniform renders take 16, 32, ... up to a quarter of it).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(32..=65536))]
+    reference_spp: Option<u32>,
     /// Image width and height in pixels (default: the scenes' own, 512, like the report's); for
     /// fewer-rays, the longer side (default 320).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16384))]
@@ -55,6 +69,11 @@ pub struct ExperimentArgs {
     /// Write every image rendered into this folder, as testN-ACCEL.png.
     #[arg(long, value_name = "DIR")]
     images: Option<PathBuf>,
+    /// seed: also write the experiment as one self-contained HTML page, DIR/index.html: the
+    /// report's claims checked, and for each test its table beside the report's figures, its plot,
+    /// the image and one cost heatmap per structure (no server, no network needed to open it).
+    #[arg(long, value_name = "DIR")]
+    report: Option<PathBuf>,
     /// No progress lines on standard error.
     #[arg(short, long)]
     quiet: bool,
@@ -64,7 +83,18 @@ pub fn run(args: ExperimentArgs) -> anyhow::Result<ExitCode> {
     if args.experiment == Experiment::FewerRays {
         return fewer_rays(args);
     }
-    anyhow::ensure!(args.scenes.is_empty() && args.thresholds.is_empty(), "scenes and --thresholds are for fewer-rays");
+    if let Some(dir) = &args.report {
+        // Checked before the experiment runs, so that it never ends in "cannot write".
+        std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    }
+    anyhow::ensure!(
+        args.scenes.is_empty()
+            && args.thresholds.is_empty()
+            && args.noise_thresholds.is_empty()
+            && args.path_size.is_none()
+            && args.reference_spp.is_none(),
+        "scenes, --thresholds, --noise-thresholds, --path-size and --reference-spp are for fewer-rays"
+    );
     let options = SeedOptions {
         size: args.size,
         tests: args.tests,
@@ -83,6 +113,14 @@ pub fn run(args: ExperimentArgs) -> anyhow::Result<ExitCode> {
     if let Some(path) = &args.json {
         experiment.write_json(path)?;
     }
+    if let Some(dir) = &args.report {
+        if !quiet {
+            eprintln!("rendering the pictures of the report...");
+        }
+        let pictures = render_seed_pictures(&experiment)?;
+        let page = write_seed_report(dir, &experiment, &pictures)?;
+        println!("wrote {}", page.display());
+    }
     if !experiment.images_identical() {
         eprintln!("error: some accelerators drew a different image than brute force (see the image column)");
         return Ok(ExitCode::from(2));
@@ -91,6 +129,7 @@ pub fn run(args: ExperimentArgs) -> anyhow::Result<ExitCode> {
 }
 
 fn fewer_rays(args: ExperimentArgs) -> anyhow::Result<ExitCode> {
+    anyhow::ensure!(args.report.is_none(), "--report is for the seed experiment");
     let mut options = FewerRaysOptions { threads: args.threads, ..FewerRaysOptions::default() };
     if !args.scenes.is_empty() {
         options.scenes = args.scenes;
@@ -102,6 +141,15 @@ fn fewer_rays(args: ExperimentArgs) -> anyhow::Result<ExitCode> {
         anyhow::ensure!(args.thresholds.iter().all(|t| (0.0..=1.0).contains(t)), "--thresholds: each between 0 and 1");
         options.thresholds = args.thresholds;
     }
+    if !args.noise_thresholds.is_empty() {
+        anyhow::ensure!(
+            args.noise_thresholds.iter().all(|t| t.is_finite() && *t > 0.0),
+            "--noise-thresholds: each greater than 0"
+        );
+        options.noise_thresholds = args.noise_thresholds;
+    }
+    options.path_size = args.path_size.unwrap_or(options.path_size);
+    options.reference_samples = args.reference_spp.unwrap_or(options.reference_samples);
     let quiet = args.quiet;
     let experiment = run_fewer_rays(&options, &mut |line| {
         if !quiet {

@@ -37,9 +37,15 @@ pub struct ImageOptions {
     /// Scale the image size by this factor, after --width and --height: 0.25 for a quick preview.
     #[arg(long, value_parser = parse_scale)]
     pub scale: Option<f64>,
-    /// Samples per pixel (overrides the scene).
+    /// Samples per pixel (overrides the scene); with a noise threshold, the most a pixel takes.
     #[arg(long)]
     pub spp: Option<u32>,
+    /// Adaptive sampling: every 8x8 block of pixels stops once its estimated relative error falls
+    /// under this (0.01 is fine, 0.05 a preview; 0 turns it off); the same as
+    /// -D image.noise_threshold=T. The first pass is image.min_samples (default, as Cycles:
+    /// 16 / T^0.3, so 64 at 0.01).
+    #[arg(long, value_name = "T", value_parser = parse_threshold)]
+    pub noise_threshold: Option<f32>,
     /// Acceleration structure: bvh-wide (the fast path, eight-wide at both levels), none (brute
     /// force), bvh-seed, bvh-seed-ordered, bvh-sah, bvh-ploc, bvh-sweep, kdtree, grid
     #[arg(long, default_value = "bvh-wide", value_parser = parse_accel)]
@@ -102,6 +108,7 @@ impl ImageOptions {
         let image = &mut scene.image;
         (image.width, image.height) = image_size(image, self.width, self.height, self.scale);
         image.samples = self.spp.unwrap_or(image.samples);
+        image.noise_threshold = self.noise_threshold.unwrap_or(image.noise_threshold);
         image.integrator = self.integrator.unwrap_or(image.integrator);
         image.output = self.output.apply(image.output);
         ImageSettings::check_limits(image.width, image.height, image.samples, image.max_depth)
@@ -139,6 +146,7 @@ impl ImageOptions {
         push("--height", self.height.map(|v| v.to_string()));
         push("--scale", self.scale.map(|v| v.to_string()));
         push("--spp", self.spp.map(|v| v.to_string()));
+        push("--noise-threshold", self.noise_threshold.map(|v| v.to_string()));
         push("--integrator", self.integrator.map(|i| i.name().to_owned()));
         args.extend(self.output.to_args());
         args
@@ -197,6 +205,13 @@ fn parse_point(s: &str) -> Result<String, String> {
     match parts.iter().map(|p| p.parse::<f32>()).collect::<Result<Vec<f32>, _>>() {
         Ok(v) if v.len() == 3 && v.iter().all(|x| x.is_finite()) => Ok(format!("[{}]", parts.join(", "))),
         _ => Err(format!("`{s}`: expected three numbers X,Y,Z, such as 0,1.5,-6")),
+    }
+}
+
+fn parse_threshold(s: &str) -> Result<f32, String> {
+    match s.parse::<f32>() {
+        Ok(x) if x.is_finite() && x >= 0.0 => Ok(x),
+        _ => Err(format!("`{s}`: expected a relative error of 0 or more, such as 0.01")),
     }
 }
 

@@ -10,6 +10,7 @@ use anyhow::Context;
 use clap::{Args, ValueEnum};
 use englobe_lab::memory::peak_rss_bytes;
 use englobe_lab::report::{StatsReport, stats_table, write_json};
+use englobe_render::adaptive::AdaptiveSampling;
 use englobe_render::tile::file::{TileHeader, VERSION, write_tile};
 use englobe_render::{HeatmapScale, PixelWindow, Renderer, TileSpec, build_world, write_cost_image, write_image_with};
 use englobe_scene::framing::{framing_scene, turntable_position};
@@ -62,6 +63,11 @@ pub struct RenderArgs {
     /// Write the statistics as JSON to this file.
     #[arg(long, value_name = "FILE")]
     stats_json: Option<PathBuf>,
+    /// With a noise threshold (--noise-threshold, image.noise_threshold), also write the samples
+    /// each pixel took: a heatmap on a linear scale up to the most taken, with its colour bar
+    /// (.png), or the raw counts (.exr).
+    #[arg(long, value_name = "FILE")]
+    samples_map: Option<PathBuf>,
     /// Stop at the last complete sample pass once this much time has passed since the command
     /// started (30s, 2m, 1.5h; a bare number is seconds) and write that image, saying so. Renders
     /// pass by pass (every pixel's first sample, then every pixel's second...), which gives the
@@ -202,6 +208,9 @@ fn render(args: &RenderArgs, interrupted: &'static std::sync::atomic::AtomicBool
     if let Some(path) = &args.stats_json {
         englobe_render::output::check_file_writable(path)?;
     }
+    if let Some(path) = &args.samples_map {
+        englobe_render::output::check_writable(path)?;
+    }
     if args.tile.is_some() || args.pixel_bounds.is_some() {
         anyhow::ensure!(
             format == englobe_render::OutputFormat::Exr,
@@ -239,6 +248,14 @@ fn render(args: &RenderArgs, interrupted: &'static std::sync::atomic::AtomicBool
     let accel = args.image.accel;
     let (width, height, samples, integrator) =
         (scene.image.width, scene.image.height, scene.image.samples, scene.image.integrator);
+    let adaptive = AdaptiveSampling::of(&scene.image, samples);
+    if let (Some(path), None) = (&args.samples_map, adaptive) {
+        anyhow::bail!(
+            "{}: every pixel takes {samples} sample(s) without a noise threshold; set --noise-threshold (and more \
+             than one sample) for a map of samples",
+            path.display()
+        );
+    }
     let piece = match (args.tile, args.pixel_bounds) {
         (Some(tile), _) => Some((tile.window(width, height).map_err(anyhow::Error::msg)?, Some(tile))),
         (None, Some(window)) => {
@@ -269,8 +286,11 @@ fn render(args: &RenderArgs, interrupted: &'static std::sync::atomic::AtomicBool
     let tiles = window.width().div_ceil(englobe_render::render::TILE_SIZE) as usize
         * window.height().div_ceil(englobe_render::render::TILE_SIZE) as usize;
     let by_passes = args.time_limit.is_some() || args.keep_partial;
-    let bar =
-        if by_passes { progress_bar(samples as usize, "passes", args.quiet) } else { tile_bar(tiles, args.quiet) };
+    let bar = match (adaptive, by_passes) {
+        (Some(_), _) => progress_bar(samples as usize, "samples", args.quiet),
+        (None, true) => progress_bar(samples as usize, "passes", args.quiet),
+        (None, false) => tile_bar(tiles, args.quiet),
+    };
     let progress = |done: usize, _total: usize| bar.set_position(done as u64);
     let out = pool.install(|| {
         let renderer = Renderer::new(&scene, &world)
@@ -284,6 +304,14 @@ fn render(args: &RenderArgs, interrupted: &'static std::sync::atomic::AtomicBool
     bar.finish_and_clear();
     let ctrl_c = interrupted.load(std::sync::atomic::Ordering::Relaxed);
     let mut exit = ExitCode::SUCCESS;
+    if !out.complete && !by_passes && adaptive.is_some() {
+        eprintln!(
+            "interrupted: stopped at {} of at most {samples} samples per pixel; no image written ({} left as it was)",
+            out.samples_done,
+            output.display()
+        );
+        return Ok(ExitCode::from(interrupt::INTERRUPTED_EXIT_CODE));
+    }
     if !out.complete && !by_passes {
         eprintln!(
             "interrupted: stopped after {} of {tiles} tiles; no image written ({} left as it was)",
@@ -299,20 +327,38 @@ fn render(args: &RenderArgs, interrupted: &'static std::sync::atomic::AtomicBool
         } else {
             format!("time limit of {} reached", show_duration(args.time_limit.unwrap_or_default()))
         };
+        let stopped = if adaptive.is_some() {
+            format!("stopped at {done} of at most {samples} samples per pixel")
+        } else {
+            format!("stopped after {done} of {samples} sample passes")
+        };
         if done == 0 || (ctrl_c && !args.keep_partial) {
-            eprintln!(
-                "{why}: stopped after {done} of {samples} sample passes; no image written ({} left as it was)",
-                output.display()
-            );
+            eprintln!("{why}: {stopped}; no image written ({} left as it was)", output.display());
             let code = if ctrl_c { interrupt::INTERRUPTED_EXIT_CODE } else { 1 };
             return Ok(ExitCode::from(code));
         }
-        eprintln!("{why}: stopped after {done} of {samples} sample passes; writing the image of the {done} complete");
+        if adaptive.is_some() {
+            eprintln!(
+                "{why}: {stopped}; writing the image of the passes complete (each pixel the mean of its samples)"
+            );
+        } else {
+            eprintln!("{why}: {stopped}; writing the image of the {done} complete");
+        }
         if ctrl_c {
             exit = ExitCode::from(interrupt::INTERRUPTED_EXIT_CODE);
         }
     }
     let samples = out.samples_done;
+    let rendered_pixels = out.window.area().max(1);
+    let samples_total = out.samples_map.as_ref().map_or(samples as u64 * rendered_pixels, |m| m.total());
+    let samples_mean = samples_total as f64 / rendered_pixels as f64;
+    if let (Some(path), Some(map)) = (&args.samples_map, &out.samples_map) {
+        write_cost_image(map, path, HeatmapScale::linear(map.max()))?;
+    }
+    let spp = match adaptive {
+        Some(a) => format!("adaptive {samples_mean:.1} spp of at most {}, threshold {}", a.max_samples, a.threshold),
+        None => format!("{samples} spp"),
+    };
 
     if let Some((window, tile)) = piece {
         let header = TileHeader {
@@ -351,7 +397,7 @@ fn render(args: &RenderArgs, interrupted: &'static std::sync::atomic::AtomicBool
             None => format!("{width}x{height}"),
         };
         println!(
-            "wrote {} ({what}, {samples} spp, {}, accel {}, {:.2} s on {} threads: load {load_seconds:.2} s, \
+            "wrote {} ({what}, {spp}, {}, accel {}, {:.2} s on {} threads: load {load_seconds:.2} s, \
              build {build_seconds:.2} s, render {:.2} s)",
             output.display(),
             integrator.name(),
@@ -364,6 +410,18 @@ fn render(args: &RenderArgs, interrupted: &'static std::sync::atomic::AtomicBool
     let peak_memory_bytes = peak_rss_bytes();
     if args.stats {
         print!("{}", stats_table(&out.stats));
+        match (&out.samples_map, adaptive) {
+            (Some(map), Some(a)) => println!(
+                "samples: {samples_total} in all, {samples_mean:.2} per pixel on average ({} to {} per pixel; \
+                 threshold {}, first pass {}, at most {})",
+                map.values().iter().min().unwrap_or(&0),
+                map.max(),
+                a.threshold,
+                a.min_samples,
+                a.max_samples
+            ),
+            _ => println!("samples: {samples_total} in all, {samples} per pixel"),
+        }
         println!("triangles: {} in the picture; build {build_seconds:.3} s", world.triangle_count());
         if let Some(bytes) = peak_memory_bytes {
             println!("peak memory: {:.1} MiB", bytes as f64 / (1 << 20) as f64);
@@ -376,6 +434,9 @@ fn render(args: &RenderArgs, interrupted: &'static std::sync::atomic::AtomicBool
             width,
             height,
             samples,
+            samples_total,
+            samples_mean,
+            noise_threshold: adaptive.map(|a| a.threshold),
             build_seconds,
             render_seconds: out.seconds,
             triangles: world.triangle_count(),

@@ -176,7 +176,8 @@ fn fewer_rays_casts_fewer_secondary_rays_for_a_measured_difference() {
     let json = dir.path().join("fewer.json");
     let scenes = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
     let out = englobe()
-        .args(["experiment", "fewer-rays", "--size", "64", "--thresholds", "0.1,0.001", "--quiet", "--json"])
+        .args(["experiment", "fewer-rays", "--size", "64", "--thresholds", "0.1,0.001", "--quiet"])
+        .args(["--path-size", "24", "--reference-spp", "64", "--noise-thresholds", "0.05", "--json"])
         .arg(&json)
         .arg(scenes.join("glass.toml"))
         .arg(scenes.join("cornell-box-path.toml"))
@@ -184,8 +185,16 @@ fn fewer_rays_casts_fewer_secondary_rays_for_a_measured_difference() {
         .expect("englobe runs");
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let table = String::from_utf8_lossy(&out.stdout);
-    assert!(table.contains("cornell-box-path.toml: path traced"), "{table}");
     let report: Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    // The path-traced Cornell box: adaptive sampling against uniform sampling, at 24 pixels.
+    let sampling = report["sampling"].as_array().unwrap();
+    let spp: Vec<(&str, f64)> =
+        sampling.iter().map(|r| (r["method"].as_str().unwrap(), r["samples_mean"].as_f64().unwrap())).collect();
+    assert_eq!(spp[..3], [("uniform, reference", 64.0), ("uniform", 16.0), ("uniform", 32.0)], "{table}");
+    assert_eq!(spp[3].0, "adaptive");
+    assert!(spp[3].1 >= 16.0 && spp[3].1 <= 64.0, "{table}");
+    assert!(sampling.iter().all(|r| r["scene"].as_str().unwrap().ends_with("cornell-box-path.toml")));
+    assert!(table.contains("uniform spp") && table.contains("ratio"), "{table}");
     let all = rows(&report);
     let method = |m: &str| all.iter().filter(|r| r["method"] == m).collect::<Vec<_>>();
     let rows: Vec<&Value> = [method("full depth"), method("adaptive depth")].concat();
@@ -261,4 +270,22 @@ fn compare_writes_a_self_contained_report_page() {
     assert_eq!(page.matches("src=\"data:image/png;base64,").count(), 4, "every picture inside the page");
     assert!(page.contains("<svg") && page.contains("<table id=\"quality\">"));
     assert!(std::fs::read_dir(&report).unwrap().count() == 1, "one file: the page holds everything");
+}
+
+#[test]
+fn the_seed_experiment_writes_its_page() {
+    let dir = tempfile::tempdir().unwrap();
+    let report = dir.path().join("seed-report");
+    let out = englobe()
+        .args(["experiment", "seed", "--size", "16", "--tests", "2", "--accel", "bvh-seed", "-q", "--report"])
+        .arg(&report)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let page = std::fs::read_to_string(report.join("index.html")).unwrap();
+    assert!(String::from_utf8_lossy(&out.stdout).contains("index.html"));
+    assert!(page.contains("<table id=\"table-2\">") && page.contains("<ul id=\"claims\">"));
+    assert_eq!(page.matches("<img ").count(), 3, "the image and the heatmaps of none and bvh-seed");
+    let refused = englobe().args(["experiment", "fewer-rays", "--report"]).arg(&report).output().unwrap();
+    assert!(String::from_utf8_lossy(&refused.stderr).contains("--report is for the seed experiment"));
 }

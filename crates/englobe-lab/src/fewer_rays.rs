@@ -2,8 +2,7 @@
 //! seed's way: rays cast and exact tests per kind of ray, the time, and what the image loses
 //! against a full render (see [`crate::image_error`]).
 //!
-//! Two methods are measured, on Whitted scenes (path-traced ones are skipped: their depth is a
-//! matter of Russian roulette, and their noise would make every square look like an edge):
+//! Two methods are measured on Whitted scenes:
 //!
 //! - adaptive depth (Hall and Greenberg 1983, "A Testbed for Realistic Image Synthesis"):
 //!   secondary rays whose contribution to the pixel would fall below a threshold are not cast
@@ -11,6 +10,10 @@
 //! - adaptive supersampling (Whitted 1980, with Mitchell's 1987 contrast; englobe-render's
 //!   `supersample`): corners first, cut where they differ, against uniform jittered
 //!   supersampling at 4 and 16 samples, all measured against 64 uniform samples per pixel.
+//!
+//! On path-traced scenes (whose depth is a matter of Russian roulette, and whose noise would make
+//! every square look like an edge) a third: adaptive sampling to a noise threshold against uniform
+//! sampling, at equal error (see [`crate::fewer_samples`]).
 
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -22,13 +25,17 @@ use englobe_render::{RayKind, RenderStats, Renderer};
 use englobe_scene::{IntegratorKind, Scene, load_scene};
 
 use crate::error::LabError;
+use crate::fewer_samples::{
+    DEFAULT_NOISE_THRESHOLDS, REFERENCE_PATH_SAMPLES, SamplingRow, sampling_rows, sampling_table,
+};
 use crate::image_error::{ImageError, image_error};
 use crate::measure::{build, thread_pool};
 use crate::report::grouped;
 
 /// The scenes measured by default, relative to the repository's root: the seed report's four
-/// tests, the glass and mirror scenes (where rays branch most) and the Sponza.
-pub const DEFAULT_SCENES: [&str; 7] = [
+/// tests, the glass and mirror scenes (where rays branch most), the Sponza, and the path-traced
+/// Cornell box.
+pub const DEFAULT_SCENES: [&str; 8] = [
     "scenes/seed/test1.toml",
     "scenes/seed/test2.toml",
     "scenes/seed/test3.toml",
@@ -36,6 +43,7 @@ pub const DEFAULT_SCENES: [&str; 7] = [
     "scenes/glass.toml",
     "scenes/mirrors.toml",
     "scenes/sponza.toml",
+    "scenes/cornell-box-path.toml",
 ];
 
 /// The adaptive-depth thresholds measured by default.
@@ -61,6 +69,14 @@ pub struct FewerRaysOptions {
     pub thresholds: Vec<f32>,
     /// Worker threads (default: all cores).
     pub threads: Option<u32>,
+    /// The longer side of path-traced scenes' images (default 128: their reference takes
+    /// thousands of samples per pixel).
+    pub path_size: u32,
+    /// Samples per pixel of path-traced scenes' reference (default [`REFERENCE_PATH_SAMPLES`]);
+    /// also adaptive sampling's maximum.
+    pub reference_samples: u32,
+    /// Noise thresholds of adaptive sampling (default: [`DEFAULT_NOISE_THRESHOLDS`]).
+    pub noise_thresholds: Vec<f32>,
 }
 
 impl Default for FewerRaysOptions {
@@ -70,6 +86,9 @@ impl Default for FewerRaysOptions {
             size: 320,
             thresholds: DEFAULT_THRESHOLDS.to_vec(),
             threads: None,
+            path_size: 128,
+            reference_samples: REFERENCE_PATH_SAMPLES,
+            noise_thresholds: DEFAULT_NOISE_THRESHOLDS.to_vec(),
         }
     }
 }
@@ -96,31 +115,42 @@ pub struct FewerRaysRow {
     pub error: ImageError,
 }
 
-/// The experiment's rows and the scenes it skipped, with why.
+/// The experiment's rows.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct FewerRays {
-    /// Every render.
+    /// Every render of a Whitted scene.
     pub rows: Vec<FewerRaysRow>,
-    /// Scenes not measured, and why.
-    pub skipped: Vec<String>,
+    /// Every render of a path-traced scene: adaptive sampling against uniform sampling.
+    pub sampling: Vec<SamplingRow>,
 }
 
 /// Runs the experiment; `progress` gets a line per render.
 pub fn run_fewer_rays(options: &FewerRaysOptions, progress: &mut dyn FnMut(String)) -> Result<FewerRays, LabError> {
     let pool = thread_pool(options.threads)?;
-    let mut out = FewerRays { rows: Vec::new(), skipped: Vec::new() };
+    let mut out = FewerRays { rows: Vec::new(), sampling: Vec::new() };
     for path in &options.scenes {
         let name = path.display().to_string();
         let mut scene = load_scene(path)?;
-        if scene.image.integrator != IntegratorKind::Whitted {
-            out.skipped.push(format!("{name}: path traced; adaptive depth applies to Whitted's recursion"));
-            continue;
-        }
+        let path_traced = scene.image.integrator != IntegratorKind::Whitted;
         let (w, h) = (scene.image.width as f64, scene.image.height as f64);
-        let scale = options.size as f64 / w.max(h);
+        let scale = if path_traced { options.path_size } else { options.size } as f64 / w.max(h);
         scene.image.width = ((w * scale).round() as u32).max(1);
         scene.image.height = ((h * scale).round() as u32).max(1);
         scene.image.min_contribution = 0.0;
+        if path_traced {
+            let (world, _) = build(&scene, AccelKind::BvhWide)?;
+            let rows = sampling_rows(
+                &name,
+                &scene,
+                &world,
+                options.reference_samples,
+                &options.noise_thresholds,
+                &pool,
+                progress,
+            )?;
+            out.sampling.extend(rows);
+            continue;
+        }
         let (world, _) = build(&scene, AccelKind::BvhWide)?;
         let render_with = |scene: &Scene,
                            adaptive: Option<AdaptiveSupersampling>|
@@ -185,6 +215,9 @@ impl FewerRays {
     /// The table: one line per render, the rays of each kind, exact tests, time, and the error.
     pub fn table(&self) -> String {
         let mut s = String::new();
+        if self.rows.is_empty() {
+            return sampling_table(&self.sampling).trim_start().to_owned();
+        }
         let _ = writeln!(
             s,
             "{:<24} {:<18} {:>8} {:>10} {:>10} {:>10} {:>10} {:>13} {:>7} {:>6} {:>7}",
@@ -217,9 +250,7 @@ impl FewerRays {
                 r.error.ssim
             );
         }
-        for skipped in &self.skipped {
-            let _ = writeln!(s, "skipped {skipped}");
-        }
+        s += &sampling_table(&self.sampling);
         s
     }
 }

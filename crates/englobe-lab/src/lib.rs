@@ -4,8 +4,8 @@
 //! scenes and figures of [`seed_report`]), its other family of speed-ups, fewer rays
 //! ([`fewer_rays`], with [`image_error`] saying what an image loses) and the comparison of every acceleration structure on one
 //! scene ([`compare`]), both built on [`measure`] (build, render, time, compare images); their
-//! reports ([`report`]: tables and JSON; [`html_report`]: the comparison as one self-contained
-//! page) and plot ([`plot`]: SVG). The `englobe` command parses its
+//! reports ([`report`]: tables and JSON; [`html_report`]: the comparison and the seed experiment, each
+//! as one self-contained page) and plot ([`plot`]: SVG). The `englobe` command parses its
 //! arguments and calls these; a program can call them as well:
 //!
 //! ```no_run
@@ -24,6 +24,7 @@
 pub mod compare;
 pub mod error;
 pub mod fewer_rays;
+pub mod fewer_samples;
 pub mod html_report;
 pub mod image_error;
 pub mod measure;

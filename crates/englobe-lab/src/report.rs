@@ -20,8 +20,14 @@ pub struct StatsReport<'a> {
     pub width: u32,
     /// Image height.
     pub height: u32,
-    /// Samples per pixel.
+    /// Samples per pixel (with adaptive sampling: the most any pixel took).
     pub samples: u32,
+    /// Samples taken over the whole image (or window).
+    pub samples_total: u64,
+    /// Samples per pixel on average.
+    pub samples_mean: f64,
+    /// The noise threshold of adaptive sampling, if it was on.
+    pub noise_threshold: Option<f32>,
     /// Seconds to build the world.
     pub build_seconds: f64,
     /// Seconds to render.

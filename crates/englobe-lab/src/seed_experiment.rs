@@ -281,7 +281,7 @@ fn table(rows: &[SeedRow], width: u32, height: u32, samples: u32, threads: usize
 }
 
 /// The report's counts as it writes them: scientific notation above a million.
-fn format_report_count(n: f64) -> String {
+pub(crate) fn format_report_count(n: f64) -> String {
     if n >= 1e6 {
         let exponent = n.log10().floor() as i32;
         format!("{:.5}e{exponent}", n / 10f64.powi(exponent))

@@ -131,6 +131,15 @@ mod tests {
         s.image.samples += 1;
         assert_ne!(base, scene_digest(&s, "accel=bvh-wide"));
         let mut s = scene();
+        s.image.noise_threshold = 0.01;
+        assert_ne!(base, scene_digest(&s, "accel=bvh-wide"), "adaptive sampling changes the pixels");
+        s.image.min_samples = Some(8);
+        assert_ne!(scene_digest(&s, "accel=bvh-wide"), {
+            let mut t = scene();
+            t.image.noise_threshold = 0.01;
+            scene_digest(&t, "accel=bvh-wide")
+        });
+        let mut s = scene();
         s.camera.fov_degrees = f32::from_bits(s.camera.fov_degrees.to_bits() + 1);
         assert_ne!(base, scene_digest(&s, "accel=bvh-wide"), "one bit of one number");
         let mut s = scene();

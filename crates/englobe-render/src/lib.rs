@@ -15,6 +15,7 @@
 //! # Ok(()) }
 //! ```
 
+pub mod adaptive;
 pub mod bsdf;
 pub mod camera;
 pub mod cost;

@@ -26,6 +26,8 @@ impl Renderer<'_> {
     /// passes; the film holds the passes completed ([`RenderOutput::samples_done`]), and
     /// [`RenderOutput::complete`] says whether that is all of them. Progress is reported as
     /// `(passes_done, passes_total)`. Work is counted if asked; the cost AOV is not recorded.
+    /// With the scene's `noise_threshold` the passes are adaptive sampling's (see
+    /// `crate::adaptive`), progress is `(samples, max_samples)`, and the cost AOV is recorded.
     pub fn render_passes(&self, deadline: Option<Instant>) -> Result<RenderOutput, RenderError> {
         if self.supersampling.is_some() {
             return Err(RenderError::Limits(
@@ -36,6 +38,9 @@ impl Renderer<'_> {
             .map_err(RenderError::Limits)?;
         if let Some(w) = self.window {
             w.check_inside(self.width, self.height).map_err(RenderError::Limits)?;
+        }
+        if let Some(adaptive) = self.adaptive_sampling()? {
+            return self.render_adaptive(adaptive, deadline);
         }
         if self.count_work {
             Ok(self.passes_with::<WorkCounts>(deadline))
@@ -121,6 +126,7 @@ impl Renderer<'_> {
             samples_done,
             seconds: start.elapsed().as_secs_f64(),
             cost: None,
+            samples_map: None,
         }
     }
 }

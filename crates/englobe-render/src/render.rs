@@ -61,6 +61,9 @@ pub struct RenderOutput {
     /// Work per pixel (nodes visited plus exact tests) over the window, if [`Renderer::record_cost`]
     /// asked for it.
     pub cost: Option<CostImage>,
+    /// Samples each pixel of the window took, when the scene's noise threshold made them vary
+    /// (adaptive sampling, see `crate::adaptive`).
+    pub samples_map: Option<CostImage>,
 }
 
 /// Renders a scene through its world: `Renderer::new(&scene, &world).size(640, 480).render()`.
@@ -174,12 +177,16 @@ impl<'a> Renderer<'a> {
         self
     }
 
-    /// Renders on the current rayon thread pool.
+    /// Renders on the current rayon thread pool; with the scene's `noise_threshold`, by adaptive
+    /// sampling (see `crate::adaptive`).
     pub fn render(&self) -> Result<RenderOutput, RenderError> {
         ImageSettings::check_limits(self.width, self.height, self.samples, self.scene.image.max_depth)
             .map_err(RenderError::Limits)?;
         if let Some(w) = self.window {
             w.check_inside(self.width, self.height).map_err(RenderError::Limits)?;
+        }
+        if let Some(adaptive) = self.adaptive_sampling()? {
+            return self.render_adaptive(adaptive, None);
         }
         if self.count_work || self.record_cost {
             Ok(self.render_with::<WorkCounts>())
@@ -276,6 +283,7 @@ impl<'a> Renderer<'a> {
             samples_done,
             seconds: start.elapsed().as_secs_f64(),
             cost,
+            samples_map: None,
         }
     }
 

@@ -57,6 +57,8 @@ pub struct ImageDef {
     #[serde(default = "five")]
     pub max_depth: u32,
     pub min_contribution: Option<crate::numbers::Fraction>,
+    pub noise_threshold: Option<crate::numbers::NonNegative>,
+    pub min_samples: Option<Spanned<u32>>,
     pub background: Option<Color>,
     pub ambient: Option<Color>,
     #[serde(default)]

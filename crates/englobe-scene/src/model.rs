@@ -36,6 +36,13 @@ pub struct ImageSettings {
     /// its contribution to the pixel, the product of the reflection and transmission factors
     /// along its path, is at least this; 0 (the default) casts every ray up to `max_depth`.
     pub min_contribution: f32,
+    /// Adaptive sampling (see englobe-render's `adaptive`): above 0, every 8 x 8 block of pixels
+    /// stops taking samples once its estimated relative error falls under this, and `samples` is
+    /// the most a pixel takes; 0 (the default) takes `samples` everywhere.
+    pub noise_threshold: f32,
+    /// Samples of adaptive sampling's first pass, before any block may stop (`None`: as Cycles
+    /// chooses them, `16 / noise_threshold^0.3`); at most `samples`.
+    pub min_samples: Option<u32>,
     /// Colour of rays that hit nothing (linear RGB).
     pub background: Vec3,
     /// Light that reaches every point, scaled by the diffuse colour (the classic ambient term).

@@ -226,6 +226,15 @@ impl Converter<'_> {
             };
             self.err(at, message)
         })?;
+        if let Some(m) = &i.min_samples {
+            let n = *m.get_ref();
+            if !(2..=crate::model::MAX_SAMPLES).contains(&n) {
+                let max = crate::model::MAX_SAMPLES;
+                return Err(
+                    self.err(m.span(), format!("min_samples = {n}: expected 2 to {max} (two halves of samples)"))
+                );
+            }
+        }
         let exposure = match i.exposure {
             Some(e) if e.get_ref().0.abs() > crate::model::MAX_EXPOSURE => {
                 return Err(self.err(
@@ -246,6 +255,8 @@ impl Converter<'_> {
             samples: i.samples,
             max_depth: i.max_depth,
             min_contribution: i.min_contribution.map_or(0.0, |f| f.0),
+            noise_threshold: i.noise_threshold.map_or(0.0, |f| f.0),
+            min_samples: i.min_samples.map(|m| *m.get_ref()),
             background: i.background.map_or(Vec3::ZERO, |c| c.0),
             ambient: i.ambient.map_or(Vec3::ZERO, |c| c.0),
             seed: i.seed,

@@ -133,6 +133,18 @@ fn image_limits() {
     check("width = 64", "width = 10000000", "10000000", "more than the limit");
     check("width = 64", "width = 64\nsamples = 0", "[image]", "samples per pixel");
     check("width = 64", "width = 64\nmax_depth = 1000", "[image]", "maximum depth");
+    check("width = 64", "width = 64\nnoise_threshold = -0.1", "-0.1", "at least 0");
+    check("width = 64", "width = 64\nmin_samples = 1", "1", "expected 2 to 65536");
+    check("width = 64", "width = 64\nmin_samples = 100000", "100000", "expected 2 to 65536");
+}
+
+#[test]
+fn adaptive_sampling_keys() {
+    let plain = parse_scene(GOOD, "good.toml".as_ref()).unwrap();
+    assert_eq!((plain.image.noise_threshold, plain.image.min_samples), (0.0, None), "off by default");
+    let text = GOOD.replacen("width = 64", "width = 64\nnoise_threshold = 0.02\nmin_samples = 8", 1);
+    let s = parse_scene(&text, "good.toml".as_ref()).unwrap();
+    assert_eq!((s.image.noise_threshold, s.image.min_samples), (0.02, Some(8)));
 }
 
 #[test]

@@ -76,6 +76,8 @@ impl Builder {
             filter,
             clamp: None,
             output: Default::default(),
+            noise_threshold: 0.0,
+            min_samples: None,
         };
         Ok((image, camera))
     }
