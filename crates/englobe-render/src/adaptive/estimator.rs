@@ -120,7 +120,7 @@ impl HalfSums {
     pub fn add(&mut self, index: u32, value: Vec3) {
         self.all += value;
         let shown = value.clamp(Vec3::ZERO, Vec3::ONE);
-        if index.is_multiple_of(2) {
+        if index % 2 == 0 {
             self.even += shown;
         } else {
             self.odd += shown;
