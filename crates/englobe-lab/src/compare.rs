@@ -158,6 +158,18 @@ pub fn run_compare(
     options: &CompareOptions,
     progress: &mut dyn FnMut(&str),
 ) -> Result<Comparison, LabError> {
+    // A noise threshold decides the samples of whole blocks of pixels, which a sample of the
+    // pixels (a slow structure's timing) cannot honour: structures are compared with the scene's
+    // samples in every pixel.
+    let uniform;
+    let scene = if scene.image.noise_threshold > 0.0 {
+        let mut s = scene.clone();
+        s.image.noise_threshold = 0.0;
+        uniform = s;
+        &uniform
+    } else {
+        scene
+    };
     let width = options.width.unwrap_or(scene.image.width);
     let height = options.height.unwrap_or(scene.image.height);
     let samples = options.spp.unwrap_or(scene.image.samples);
@@ -433,4 +445,29 @@ fn quality_table(rows: &[CompareRow]) -> String {
         );
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_noise_threshold_is_compared_with_every_sample_even_on_a_sample_of_the_pixels() {
+        let mut scene = englobe_scene::parse_scene(englobe_render::DEFAULT_SCENE, "default.toml".as_ref()).unwrap();
+        scene.image.noise_threshold = 0.05;
+        scene.image.integrator = englobe_scene::IntegratorKind::Path;
+        // A budget of nothing: every structure but the fastest is timed on a sample of the pixels.
+        let options = CompareOptions {
+            width: Some(64),
+            height: Some(48),
+            spp: Some(4),
+            accel: vec![AccelKind::BvhSah],
+            budget: 0.0,
+            ..CompareOptions::default()
+        };
+        let c = run_compare(&scene, "default", &options, &mut |_| {}).unwrap();
+        assert!(c.rows.iter().any(|r| r.sampled), "the probe chose a stride");
+        assert!(c.images_equal());
+        assert_eq!(c.samples, 4);
+    }
 }

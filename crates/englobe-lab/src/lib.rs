@@ -2,7 +2,8 @@
 //!
 //! englobe's research, as a library: the seed report's experiment ([`seed_experiment`], on the
 //! scenes and figures of [`seed_report`]), its other family of speed-ups, fewer rays
-//! ([`fewer_rays`], with [`image_error`] saying what an image loses) and the comparison of every acceleration structure on one
+//! ([`fewer_rays`], and [`fewer_samples`] for the path tracer's adaptive sampling, with
+//! [`image_error`] saying what an image loses) and the comparison of every acceleration structure on one
 //! scene ([`compare`]), both built on [`measure`] (build, render, time, compare images); their
 //! reports ([`report`]: tables and JSON; [`html_report`]: the comparison and the seed experiment, each
 //! as one self-contained page) and plot ([`plot`]: SVG). The `englobe` command parses its

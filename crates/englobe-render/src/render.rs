@@ -54,7 +54,8 @@ pub struct RenderOutput {
     /// the tiles of its passes' pixels: all of them, or none).
     pub tiles_done: usize,
     /// Samples per pixel the film holds: all those asked for, unless a render by passes stopped
-    /// early (see [`Renderer::render_passes`]).
+    /// early (see [`Renderer::render_passes`]); with a noise threshold, the most any pixel took
+    /// (each pixel's own are in [`RenderOutput::samples_map`]).
     pub samples_done: u32,
     /// Wall-clock seconds spent rendering.
     pub seconds: f64,

@@ -40,7 +40,7 @@
 //! handful of samples, and rare bright paths need a chance to show), then passes that add a
 //! quarter of the samples taken so far (16, 20, 25, 32, 40, 50, ...), up to `samples`. Geometric
 //! steps keep the number of looks at the estimate small (each look is a chance to stop on an
-//! unlucky low estimate: 19 passes from 16 to 1 024 samples) while a block stops within 1.25 times
+//! unlucky low estimate: 20 passes from 16 to 1 024 samples) while a block stops within 1.25 times
 //! the samples it needed (1.12 times on average), which is most of what adaptive sampling saves
 //! where noise is even.
 

@@ -78,8 +78,8 @@ impl Renderer<'_> {
         }
         if self.stride > 1 {
             return Err(RenderError::Limits(format!(
-                "a noise threshold decides per {BLOCK_SIZE}x{BLOCK_SIZE} block of pixels, so it cannot render every \
-                 {}-th pixel alone; set image.noise_threshold = 0",
+                "a noise threshold decides per {BLOCK_SIZE}x{BLOCK_SIZE} block of pixels, so it cannot render a \
+                 sample of the pixels (1 in {0}x{0}); set image.noise_threshold = 0",
                 self.stride
             )));
         }
