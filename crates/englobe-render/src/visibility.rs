@@ -42,7 +42,7 @@ impl<'a> Visibility<'a> {
         self.world
     }
 
-    /// Whether `hit` is on surface that is there (not cut out, or covered at this point).
+    /// Whether `hit` is on a surface that is there (not cut out, or covered at this point).
     fn solid(&self, hit: &WorldHit) -> bool {
         let object = &self.scene.objects[hit.object as usize];
         let m = &self.scene.materials[object.material_of(hit.prim) as usize];
