@@ -232,11 +232,11 @@ impl<'a> PathTracer<'a> {
             };
             let s = Surface::at(self.scene, self.world, &ray, &hit);
             // Surfaces emit from their front side only (outward normal, or the winding's normal),
-            // or from both when the material is double-sided.
+            // as physical lamps do.
             let emission = s.params.emission;
-            if emission != Vec3::ZERO && (s.entering || s.material.double_sided) {
+            if emission != Vec3::ZERO && s.entering {
                 let weight = match bounce_pdf {
-                    Some(pdf) if s.entering && self.is_sampled_emitter(&hit, &s) => {
+                    Some(pdf) if self.is_sampled_emitter(&hit, &s) => {
                         let pdf_light = self.emitters.area_pdf() * hit.t * hit.t / (-s.d.dot(s.n)).max(1e-12);
                         power_heuristic(pdf, pdf_light)
                     }
