@@ -96,19 +96,22 @@ impl<'a> Surface<'a> {
     ) {
         let origin = self.outside();
         for light in &scene.lights {
-            let (shadow_ray, to_light, radiance) = match *light {
+            let (to_light, radiance) = match *light {
                 Light::Point { position, power } => {
                     // Shading uses the true point; only the shadow ray starts off the surface.
                     let v = position - self.p;
                     let dist2 = v.length_squared();
-                    let shadow = Ray::segment(origin, position - origin, 0.0, SHADOW_RAY_END);
-                    (shadow, v / dist2.sqrt(), power / dist2)
+                    (v / dist2.sqrt(), power / dist2)
                 }
-                Light::Directional { direction, radiance } => (Ray::new(origin, -direction), -direction, radiance),
+                Light::Directional { direction, radiance } => (-direction, radiance),
             };
             if to_light.dot(self.n) <= 0.0 || !to_light.is_finite() {
                 continue; // the light is behind the surface
             }
+            let shadow_ray = match *light {
+                Light::Point { position, .. } => Ray::segment(origin, position - origin, 0.0, SHADOW_RAY_END),
+                Light::Directional { direction, .. } => Ray::new(origin, -direction),
+            };
             tally.rays[RayKind::Shadow as usize] += 1;
             if vis.any_hit(&shadow_ray, &mut tally.work[RayKind::Shadow as usize]) {
                 continue;

@@ -188,7 +188,15 @@ impl MaterialTextures {
 
     /// True when no slot holds a texture.
     pub fn is_empty(&self) -> bool {
-        self.slots().is_empty()
+        // Asked at every hit: the slots are looked at in place rather than listed.
+        let MaterialTextures { base_color, metallic_roughness, normal, emission, alpha, specular, occlusion } = self;
+        base_color.is_none()
+            && metallic_roughness.is_none()
+            && normal.is_none()
+            && emission.is_none()
+            && alpha.is_none()
+            && specular.is_none()
+            && occlusion.is_none()
     }
 
     /// Every reference with its texture index moved by `offset` (textures of a mesh file

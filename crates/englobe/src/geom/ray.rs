@@ -4,7 +4,7 @@
 //! direction component (of either sign) gets an inverse of `+inf`, never `-inf`: the slab test in
 //! [`crate::Aabb`] relies on that to treat a ray lying in a box face consistently (see there).
 
-use glam::Vec3;
+use glam::{Vec3, Vec3A};
 
 /// A ray `origin + t * dir` for `t` in the closed interval `t_min..=t_max`.
 ///
@@ -32,13 +32,7 @@ impl Ray {
     /// A ray over `t_min..=t_max`.
     #[inline]
     pub fn segment(origin: Vec3, dir: Vec3, t_min: f32, t_max: f32) -> Self {
-        Ray {
-            origin,
-            dir,
-            inv_dir: Vec3::new(safe_inverse(dir.x), safe_inverse(dir.y), safe_inverse(dir.z)),
-            t_min,
-            t_max,
-        }
+        Ray { origin, dir, inv_dir: safe_inverse(dir), t_min, t_max }
     }
 
     /// The origin.
@@ -77,9 +71,13 @@ impl Ray {
     /// traversing anything.
     #[inline]
     pub fn is_valid(&self) -> bool {
-        self.origin.is_finite()
-            && self.dir.is_finite()
-            && self.dir != Vec3::ZERO
+        // Every query starts here, so the six coordinates are checked in two vector operations:
+        // `x - x` is zero for a finite `x` and NaN for an infinite or NaN one, so the sum of both
+        // differences is zero exactly when all six are finite.
+        let (o, d) = (Vec3A::from(self.origin), Vec3A::from(self.dir));
+        let finite = ((o - o) + (d - d)).cmpeq(Vec3A::ZERO).all();
+        finite
+            && d.cmpne(Vec3A::ZERO).any()
             && self.t_min <= self.t_max
             && self.t_min < f32::INFINITY
             && self.t_max > f32::NEG_INFINITY
@@ -88,9 +86,12 @@ impl Ray {
 
 /// `1 / x`, except that both zeros map to `+inf` so that the slab test's NaN handling only ever
 /// has to deal with one sign.
+/// `1 / x` of each component, `+inf` for a zero of either sign: one vector division, as every
+/// ray pays it.
 #[inline(always)]
-fn safe_inverse(x: f32) -> f32 {
-    if x == 0.0 { f32::INFINITY } else { 1.0 / x }
+fn safe_inverse(x: Vec3) -> Vec3 {
+    let x = Vec3A::from(x);
+    Vec3A::select(x.cmpeq(Vec3A::ZERO), Vec3A::INFINITY, Vec3A::ONE / x).into()
 }
 
 #[cfg(test)]

@@ -241,11 +241,10 @@ impl TriangleMesh {
     /// The normal for shading at barycentric `(u, v)` on triangle `i`: interpolated from the
     /// vertex normals when the mesh has them, the geometric normal otherwise.
     pub fn shading_normal(&self, i: u32, u: f32, v: f32) -> Vec3 {
-        let geometric = self.geometric_normal(i);
-        let Some(normals) = &self.normals else { return geometric };
+        let Some(normals) = &self.normals else { return self.geometric_normal(i) };
         let [a, b, c] = self.triangles[i as usize];
         let n = normals[a as usize] * (1.0 - u - v) + normals[b as usize] * u + normals[c as usize] * v;
-        n.try_normalize().unwrap_or(geometric)
+        n.try_normalize().unwrap_or_else(|| self.geometric_normal(i))
     }
 }
 

@@ -103,52 +103,19 @@ impl World {
         let mut best = self
             .triangles
             .as_ref()
-            .and_then(|t| t.closest_hit_filtered(ray, counters, Located { world: self, filter: &mut filter }))
+            .and_then(|t| t.closest_hit_of_valid(ray, counters, Located { world: self, filter: &mut filter }))
             .map(|h| {
                 let (object, prim) = self.locate(h.prim);
                 WorldHit { t: h.t, object, prim, u: h.u, v: h.v }
             });
-        // Work inside instances is counted apart (the structure holds `counters` during its query)
-        // and merged afterwards.
-        let mut nested = C::default();
-        let mut instance_hits = ClosestInstance::default();
-        // Only the teaching structures test mesh triangles through their closure.
-        let mut watertight = None;
-        let bounded = ray.with_range(ray.t_min, best.map_or(ray.t_max, |b| b.t));
-        let found = self.accel_in_use().then(|| {
-            self.accel.closest_hit(&bounded, counters, |i, r| {
-                let (object, local) = self.locate(self.accel_prim(i));
-                let h = match &self.objects[object as usize] {
-                    Object::Shape(s) => s.intersect(r)?,
-                    Object::Mesh(m) => {
-                        m.intersect_with(local, r, watertight.get_or_insert_with(|| WatertightRay::new(ray)))?
-                    }
-                    Object::Instance(inst) => {
-                        let hit = self.instance_closest_hit(object, inst, r, &mut nested, &mut filter)?;
-                        instance_hits.offer(i, &hit);
-                        return Some(PrimHit { t: hit.t, u: hit.u, v: hit.v });
-                    }
-                };
-                let candidate = WorldHit { t: h.t, object, prim: local, u: h.u, v: h.v };
-                (F::ACCEPTS_ALL || filter.accept(&candidate)).then_some(h)
-            })
-        });
-        counters.merge(&nested);
-        if let Some(h) = found.flatten() {
-            let (object, local) = self.locate(self.accel_prim(h.prim));
-            let prim = match &self.objects[object as usize] {
-                Object::Instance(inst) => instance_hits.triangle(h.prim, h.t).unwrap_or_else(|| {
-                    // Only a structure that breaks the tie rule of `HitRecord::offer` gets here:
-                    // ask the instance again, up to the hit.
-                    let r = ray.with_range(ray.t_min, h.t);
-                    self.instance_closest_hit(object, inst, &r, &mut C::default(), &mut filter).map_or(0, |x| x.prim)
-                }),
-                _ => local,
-            };
-            let hit = WorldHit { t: h.t, object, prim, u: h.u, v: h.v };
-            if beats(&hit, best.as_ref()) {
-                best = Some(hit);
-            }
+        if self.accel_in_use()
+            && let Some(hit) = self.accel_closest_hit(ray, best.map_or(ray.t_max, |b| b.t), counters, &mut filter)
+            && beats(&hit, best.as_ref())
+        {
+            best = Some(hit);
+        }
+        if self.unbounded.is_empty() {
+            return best;
         }
         let mut bounded = ray.with_range(ray.t_min, best.map_or(ray.t_max, |b| b.t));
         for &object in &self.unbounded {
@@ -163,6 +130,53 @@ impl World {
             }
         }
         best
+    }
+
+    /// The closest hit among the primitives of [`World::accel`] (shapes, instances, and on the
+    /// teaching structures the meshes' triangles) before `t_max`.
+    fn accel_closest_hit<C: Counters, F: HitFilter<WorldHit>>(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        counters: &mut C,
+        filter: &mut F,
+    ) -> Option<WorldHit> {
+        // Work inside instances is counted apart (the structure holds `counters` during its query)
+        // and merged afterwards.
+        let mut nested = C::default();
+        let mut instance_hits = ClosestInstance::default();
+        // Only the teaching structures test mesh triangles through their closure.
+        let mut watertight = None;
+        let bounded = ray.with_range(ray.t_min, t_max);
+        let found = self.accel.closest_hit(&bounded, counters, |i, r| {
+            let (object, local) = self.locate(self.accel_prim(i));
+            let h = match &self.objects[object as usize] {
+                Object::Shape(s) => s.intersect(r)?,
+                Object::Mesh(m) => {
+                    m.intersect_with(local, r, watertight.get_or_insert_with(|| WatertightRay::new(ray)))?
+                }
+                Object::Instance(inst) => {
+                    let hit = self.instance_closest_hit(object, inst, r, &mut nested, filter)?;
+                    instance_hits.offer(i, &hit);
+                    return Some(PrimHit { t: hit.t, u: hit.u, v: hit.v });
+                }
+            };
+            let candidate = WorldHit { t: h.t, object, prim: local, u: h.u, v: h.v };
+            (F::ACCEPTS_ALL || filter.accept(&candidate)).then_some(h)
+        });
+        counters.merge(&nested);
+        let h = found?;
+        let (object, local) = self.locate(self.accel_prim(h.prim));
+        let prim = match &self.objects[object as usize] {
+            Object::Instance(inst) => instance_hits.triangle(h.prim, h.t).unwrap_or_else(|| {
+                // Only a structure that breaks the tie rule of `HitRecord::offer` gets here:
+                // ask the instance again, up to the hit.
+                let r = ray.with_range(ray.t_min, h.t);
+                self.instance_closest_hit(object, inst, &r, &mut C::default(), filter).map_or(0, |x| x.prim)
+            }),
+            _ => local,
+        };
+        Some(WorldHit { t: h.t, object, prim, u: h.u, v: h.v })
     }
 
     /// [`World::any_hit`] counting only the hits `filter` accepts.
@@ -188,7 +202,7 @@ impl World {
             || self
                 .triangles
                 .as_ref()
-                .is_some_and(|t| t.any_hit_filtered(ray, counters, Located { world: self, filter: &mut filter }))
+                .is_some_and(|t| t.any_hit_of_valid(ray, counters, Located { world: self, filter: &mut filter }))
         {
             return true;
         }

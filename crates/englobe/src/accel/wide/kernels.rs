@@ -39,8 +39,8 @@ impl NodeKernel for Portable {
             let (mut enter, mut exit) = (Vec4::splat(ray.t_min), Vec4::splat(limit));
             for a in 0..3 {
                 let (o, inv) = (Vec4::splat(ray.origin[a]), Vec4::splat(ray.inv_dir[a]));
-                let t_near = (row(ray.near[a]) - o) * inv;
-                let t_far = (row(ray.far[a]) - o) * Vec4::splat(ray.inv_far[a]);
+                let t_near = (row(ray.row_index(a, 0)) - o) * inv;
+                let t_far = (row(ray.row_index(a, 1)) - o) * Vec4::splat(ray.inv_far[a]);
                 enter = Vec4::select(t_near.cmpgt(enter), t_near, enter);
                 exit = Vec4::select(t_far.cmplt(exit), t_far, exit);
             }

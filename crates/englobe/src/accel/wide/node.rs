@@ -99,6 +99,8 @@ pub fn index_of(reference: u32) -> u32 {
 
 /// A ray prepared for the slab tests of wide nodes: which row is the near plane on each axis, by
 /// the sign of the inverse direction, exactly as [`Aabb::slab_distances`] chooses it.
+///
+/// Made once per query, so it holds only what the node test reads, computed without branches.
 #[derive(Clone, Copy, Debug)]
 pub struct NodeRay {
     /// The ray's origin.
@@ -108,44 +110,42 @@ pub struct NodeRay {
     /// The inverse direction times [`ROBUST_FAR_SCALE`]: the far planes' factor, rounded once per
     /// ray instead of once per node (see [`child_entry_scalar`]).
     pub inv_far: [f32; 3],
-    /// Row of the near plane on each axis.
-    pub near: [usize; 3],
-    /// Row of the far plane on each axis.
-    pub far: [usize; 3],
     /// The ray's `t_min`.
     pub t_min: f32,
-    /// Bit `a` set if the ray goes down axis `a`.
-    pub negative_bits: u32,
     /// Byte offsets of the near and far rows of each axis in [`WideNode::bounds`], for kernels
     /// that load rows without an index check. Private, so that only [`NodeRay::new`] makes them,
     /// always below `ROWS * WIDTH * 4`.
-    row_bytes: [[usize; 2]; 3],
+    row_bytes: [[u32; 2]; 3],
 }
+
+/// Bytes of one row of [`WideNode::bounds`].
+const ROW_BYTES: u32 = (WIDTH * 4) as u32;
 
 impl NodeRay {
     /// Prepares `ray`.
     #[inline(always)]
     pub fn new(ray: &Ray) -> Self {
-        let inv = ray.inv_dir().to_array();
-        let mut near = [0; 3];
-        let mut far = [0; 3];
-        let mut negative_bits = 0;
-        for a in 0..3 {
-            let down = !(inv[a] >= 0.0);
-            near[a] = 2 * a + down as usize;
-            far[a] = 2 * a + 1 - down as usize;
-            negative_bits |= (down as u32) << a;
-        }
+        let inv = ray.inv_dir();
+        // Bit `a` set if the ray goes down axis `a` (`!(inv >= 0)`, as the scalar slab test
+        // decides it; the inverse of a zero component is `+inf`, never `-inf`).
+        let down = inv.cmplt(glam::Vec3::ZERO).bitmask();
+        let rows = |a: u32| {
+            let d = (down >> a) & 1;
+            [(2 * a + d) * ROW_BYTES, (2 * a + 1 - d) * ROW_BYTES]
+        };
         NodeRay {
             origin: ray.origin().to_array(),
-            inv_dir: inv,
-            inv_far: inv.map(|i| i * ROBUST_FAR_SCALE),
-            near,
-            far,
+            inv_dir: inv.to_array(),
+            inv_far: (inv * ROBUST_FAR_SCALE).to_array(),
             t_min: ray.t_min,
-            negative_bits,
-            row_bytes: [0, 1, 2].map(|a| [near[a], far[a]].map(|row| row * WIDTH * 4)),
+            row_bytes: [rows(0), rows(1), rows(2)],
         }
+    }
+
+    /// Row of the near (`side` 0) or far (`side` 1) plane of `axis` in [`WideNode::bounds`].
+    #[inline(always)]
+    pub fn row_index(&self, axis: usize, side: usize) -> usize {
+        (self.row_bytes[axis][side] / ROW_BYTES) as usize
     }
 }
 
@@ -154,7 +154,7 @@ impl NodeRay {
     #[inline(always)]
     pub fn row<'a>(&self, node: &'a WideNode, axis: usize, side: usize) -> &'a [f32; WIDTH] {
         debug_assert!(axis < 3 && side < 2);
-        let offset = self.row_bytes[axis][side];
+        let offset = self.row_bytes[axis][side] as usize;
         // SAFETY: `NodeRay::new`, the only maker of `row_bytes`, gives each the start of a row of
         // `bounds` (row < ROWS), a multiple of a row's size; rows are arrays of WIDTH floats.
         unsafe { &*((node.bounds.as_ptr() as *const u8).add(offset) as *const [f32; WIDTH]) }
@@ -170,6 +170,29 @@ pub fn reach(t_max: f32) -> f32 {
     t_max + t_max.abs() * (ROBUST_FAR_SCALE - 1.0)
 }
 
+/// Whether `ray` may enter `bounds` within `t_min..=limit`: a slab test of one box, done with
+/// three-lane vectors before any per-query state is prepared, so that a query whose ray passes
+/// beside the whole tree costs a few instructions. It computes each plane's distance exactly as
+/// the node test does (the same differences and products), so for a box inside `bounds` it never
+/// says no where the node test would say yes: rounding is monotonic, so the outer box's entry is
+/// no later and its exit no earlier. A NaN distance (an origin on the plane of a parallel ray)
+/// constrains nothing, as in the node test.
+#[inline(always)]
+pub fn may_enter(bounds: &Aabb, ray: &Ray, limit: f32) -> bool {
+    use glam::Vec3A;
+    let o = Vec3A::from(ray.origin());
+    let inv = Vec3A::from(ray.inv_dir());
+    let down = inv.cmplt(Vec3A::ZERO);
+    let (lo, hi) = (Vec3A::from(bounds.min) - o, Vec3A::from(bounds.max) - o);
+    let near = Vec3A::select(down, hi, lo) * inv;
+    let far = Vec3A::select(down, lo, hi) * (inv * ROBUST_FAR_SCALE);
+    let near = Vec3A::select(near.is_nan_mask(), Vec3A::NEG_INFINITY, near);
+    let far = Vec3A::select(far.is_nan_mask(), Vec3A::INFINITY, far);
+    let enter = near.max_element();
+    let exit = far.min_element();
+    (if enter > ray.t_min { enter } else { ray.t_min }) <= (if exit < limit { exit } else { limit })
+}
+
 /// The slab test of one child, one plane at a time: the reference every SIMD kernel must match bit
 /// for bit. Returns the entry distance if the ray enters the box within `t_min..=limit`.
 ///
@@ -182,8 +205,8 @@ pub fn reach(t_max: f32) -> f32 {
 pub fn child_entry_scalar(node: &WideNode, slot: usize, ray: &NodeRay, limit: f32) -> Option<f32> {
     let (mut enter, mut exit) = (ray.t_min, limit);
     for a in 0..3 {
-        let t_near = (node.bounds[ray.near[a]][slot] - ray.origin[a]) * ray.inv_dir[a];
-        let t_far = (node.bounds[ray.far[a]][slot] - ray.origin[a]) * ray.inv_far[a];
+        let t_near = (node.bounds[ray.row_index(a, 0)][slot] - ray.origin[a]) * ray.inv_dir[a];
+        let t_far = (node.bounds[ray.row_index(a, 1)][slot] - ray.origin[a]) * ray.inv_far[a];
         enter = if t_near > enter { t_near } else { enter };
         exit = if t_far < exit { t_far } else { exit };
     }
@@ -225,8 +248,50 @@ mod tests {
     }
 
     #[test]
+    fn the_outer_box_test_never_refuses_a_ray_a_child_takes() {
+        use rand::{RngExt, SeedableRng};
+        // Integer planes and axis-parallel directions of both signs, so that origins on planes
+        // (NaN distances), rays in faces and flat boxes all occur.
+        let mut rng = rand_pcg::Pcg32::seed_from_u64(0x5eed_0b0c);
+        let values = [-2.0f32, -1.0, -0.0, 0.0, 0.5, 1.0, 2.0];
+        let dirs = [-1.0f32, -0.0, 0.0, 0.3, 1.0];
+        let mut pick = |v: &[f32]| v[rng.random_range(0..v.len())];
+        let (mut entered, mut refused) = (0, 0);
+        for i in 0..50_000 {
+            let mut node = WideNode::EMPTY_NODE;
+            let mut outer = Aabb::EMPTY;
+            for slot in 0..1 + i % WIDTH {
+                let a = Vec3::new(pick(&values), pick(&values), pick(&values));
+                let b = Vec3::new(pick(&values), pick(&values), pick(&values));
+                let child = Aabb::new(a.min(b), a.max(b));
+                node.set_child(slot, &child, slot as u32, 0);
+                outer = outer.union(&child);
+            }
+            let origin = Vec3::new(pick(&values), pick(&values), pick(&values)) * 1.5;
+            let dir = Vec3::new(pick(&dirs), pick(&dirs), pick(&dirs));
+            let t_max = [f32::INFINITY, 1.0, 2.5][i % 3];
+            let ray = Ray::segment(origin, dir, 0.0, t_max);
+            if !ray.is_valid() {
+                continue;
+            }
+            let r = NodeRay::new(&ray);
+            let limit = reach(t_max);
+            let any_child = (0..WIDTH).any(|slot| child_entry_scalar(&node, slot, &r, limit).is_some());
+            let may = may_enter(&outer, &ray, limit);
+            assert!(may || !any_child, "{ray:?} enters a child of {node:?} but not {outer:?}");
+            entered += any_child as u32;
+            refused += !may as u32;
+        }
+        // Both outcomes occur often enough for the test to mean something.
+        assert!(entered > 5_000 && refused > 5_000, "{entered} entered, {refused} refused");
+    }
+
+    #[test]
     fn near_rows_follow_the_direction_signs() {
         let r = NodeRay::new(&Ray::new(Vec3::ZERO, Vec3::new(-1.0, 0.0, -0.0)));
-        assert_eq!((r.near, r.far, r.negative_bits), ([1, 2, 4], [0, 3, 5], 0b001));
+        let rows = |side| [0, 1, 2].map(|a| r.row_index(a, side));
+        assert_eq!((rows(0), rows(1)), ([1, 2, 4], [0, 3, 5]));
+        let r = NodeRay::new(&Ray::new(Vec3::ZERO, Vec3::new(0.5, -2.0, -1.0)));
+        assert_eq!([0, 1, 2].map(|a| r.row_index(a, 0)), [0, 3, 5]);
     }
 }

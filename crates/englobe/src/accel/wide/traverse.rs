@@ -55,9 +55,13 @@ pub trait Leaves<C: Counters> {
 }
 
 /// Asks for every child of `node` in `mask` (the ones a ray enters), so that their cache misses
-/// overlap instead of following one another as the walk reaches them.
+/// overlap instead of following one another as the walk reaches them. A lone child is not asked
+/// for: the walk reads it next, so there is nothing for its miss to overlap with.
 #[inline(always)]
 fn prefetch_children<C: Counters, L: Leaves<C>>(nodes: &[WideNode], node: &WideNode, mut mask: u32, leaves: &L) {
+    if mask & mask.wrapping_sub(1) == 0 {
+        return;
+    }
     while mask != 0 {
         let i = mask.trailing_zeros() as usize;
         mask &= mask - 1;

@@ -11,7 +11,7 @@ use glam::Vec3;
 use super::convert::{ConvertOptions, LeafSink, convert};
 use super::dispatch;
 use super::isa::{Isa, IsaUnavailable};
-use super::node::{NodeRay, WideNode, reach};
+use super::node::{NodeRay, WideNode, may_enter, reach};
 use super::presplit::presplit;
 use super::traverse::Leaves;
 use super::triangles::{LANES, TriBlock, TriRay, UNUSED, intersect_block, is_storable};
@@ -260,7 +260,23 @@ impl TriangleBvh {
         counters: &mut C,
         filter: F,
     ) -> Option<Hit> {
-        if !ray.is_valid() || self.nodes.is_empty() {
+        if !ray.is_valid() {
+            return None;
+        }
+        self.closest_hit_of_valid(ray, counters, filter)
+    }
+
+    /// [`TriangleBvh::closest_hit_filtered`] of a ray the caller checked with [`Ray::is_valid`]
+    /// (a world query checks once for all its structures).
+    #[inline]
+    pub(crate) fn closest_hit_of_valid<C: Counters, F: HitFilter<Hit>>(
+        &self,
+        ray: &Ray,
+        counters: &mut C,
+        filter: F,
+    ) -> Option<Hit> {
+        debug_assert!(ray.is_valid());
+        if self.nodes.is_empty() || !may_enter(&self.bounds, ray, reach(ray.t_max)) {
             return None;
         }
         let mut leaves =
@@ -272,7 +288,19 @@ impl TriangleBvh {
     /// [`TriangleBvh::any_hit`] counting only the hits `filter` accepts.
     #[inline]
     pub fn any_hit_filtered<C: Counters, F: HitFilter<Hit>>(&self, ray: &Ray, counters: &mut C, filter: F) -> bool {
-        if !ray.is_valid() || self.nodes.is_empty() {
+        ray.is_valid() && self.any_hit_of_valid(ray, counters, filter)
+    }
+
+    /// [`TriangleBvh::any_hit_filtered`] of a ray the caller checked with [`Ray::is_valid`].
+    #[inline]
+    pub(crate) fn any_hit_of_valid<C: Counters, F: HitFilter<Hit>>(
+        &self,
+        ray: &Ray,
+        counters: &mut C,
+        filter: F,
+    ) -> bool {
+        debug_assert!(ray.is_valid());
+        if self.nodes.is_empty() || !may_enter(&self.bounds, ray, reach(ray.t_max)) {
             return false;
         }
         let mut leaves =
@@ -379,7 +407,7 @@ impl<C: Counters, F: HitFilter<Hit>> Leaves<C> for TriangleLeaves<'_, F> {
                 let lane = mask.trailing_zeros() as usize;
                 mask &= mask - 1;
                 if block.ids[lane] != UNUSED
-                    && let Some(h) = ray.scalar(block, lane, self.t_max)
+                    && let Some(h) = TriRay::scalar(source, block, lane, self.t_max)
                 {
                     let hit = Hit { t: h.t, prim: block.ids[lane], u: h.u, v: h.v };
                     offer(&mut self.best, &mut self.t_max, &mut self.filter, hit);
@@ -442,11 +470,11 @@ impl<C: Counters, F: HitFilter<Hit>> Leaves<C> for TriangleLeaves<'_, F> {
                 let lane = mask.trailing_zeros() as usize;
                 mask &= mask - 1;
                 if F::ACCEPTS_ALL {
-                    if ray.scalar(block, lane, self.t_max).is_some() {
+                    if TriRay::scalar(source, block, lane, self.t_max).is_some() {
                         return true;
                     }
                 } else if block.ids[lane] != UNUSED
-                    && let Some(h) = ray.scalar(block, lane, self.t_max)
+                    && let Some(h) = TriRay::scalar(source, block, lane, self.t_max)
                     && self.filter.accept(&Hit { t: h.t, prim: block.ids[lane], u: h.u, v: h.v })
                 {
                     return true;

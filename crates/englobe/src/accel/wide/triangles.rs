@@ -79,13 +79,10 @@ pub fn is_storable(v: &[Vec3; 3]) -> bool {
 }
 
 /// A ray prepared for block tests: the watertight test's constants, and what the box-stretch
-/// correction of a hit needs.
+/// correction of a hit needs. The ray itself is not copied in: the rare special lanes get it from
+/// the caller (see [`TriRay::scalar`]).
 #[derive(Clone, Copy, Debug)]
 pub struct TriRay {
-    /// The ray itself, for the scalar test of special lanes.
-    pub ray: Ray,
-    /// Its watertight constants, for the same.
-    pub watertight: WatertightRay,
     origin: [Vec4; 3],
     inv_dir: [Vec4; 3],
     axes: [usize; 3],
@@ -100,8 +97,6 @@ impl TriRay {
         let watertight = WatertightRay::new(ray);
         let (o, inv, s) = (ray.origin(), ray.inv_dir(), watertight.shear());
         TriRay {
-            ray: *ray,
-            watertight,
             origin: [0, 1, 2].map(|a| Vec4::splat(o[a])),
             inv_dir: [0, 1, 2].map(|a| Vec4::splat(inv[a])),
             axes: watertight.axes(),
@@ -110,12 +105,13 @@ impl TriRay {
         }
     }
 
-    /// The scalar test of lane `lane` with the interval `t_min..=t_max`: for special lanes.
+    /// The scalar test of lane `lane` with the interval `ray.t_min..=t_max`, `ray` being the ray
+    /// this was prepared from: for special lanes.
     #[inline(never)]
     #[cold]
-    pub fn scalar(&self, block: &TriBlock, lane: usize, t_max: f32) -> Option<PrimHit> {
+    pub fn scalar(ray: &Ray, block: &TriBlock, lane: usize, t_max: f32) -> Option<PrimHit> {
         let [a, b, c] = block.vertices(lane);
-        intersect_triangle(&self.ray.with_range(self.ray.t_min, t_max), &self.watertight, a, b, c)
+        intersect_triangle(&ray.with_range(ray.t_min, t_max), &WatertightRay::new(ray), a, b, c)
     }
 }
 
@@ -250,7 +246,7 @@ mod tests {
         for (lane, (_, [a, b, c])) in tris.iter().enumerate() {
             let expected = intersect_triangle(ray, &w, *a, *b, *c);
             let lane_hit = if got.special >> lane & 1 != 0 {
-                r.scalar(&block, lane, ray.t_max)
+                TriRay::scalar(ray, &block, lane, ray.t_max)
             } else if got.hit >> lane & 1 != 0 {
                 Some(PrimHit { t: got.t[lane], u: got.u[lane], v: got.v[lane] })
             } else {
