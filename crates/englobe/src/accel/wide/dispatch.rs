@@ -25,8 +25,7 @@ pub fn closest<C: Counters, L: Leaves<C>>(
 ) {
     debug_assert!(isa.is_available());
     match isa {
-        // SAFETY: the portable kernel needs nothing beyond the target's baseline.
-        Isa::Portable => unsafe { traverse::closest(Portable, nodes, depth, ray, leaves, counters) },
+        Isa::Portable => portable::closest(nodes, depth, ray, leaves, counters),
         // SAFETY: the structure's instruction set is one the processor has (module documentation).
         #[cfg(target_arch = "x86_64")]
         Isa::Avx2 => unsafe { x86::closest_avx2(nodes, depth, ray, leaves, counters) },
@@ -51,8 +50,7 @@ pub fn any<C: Counters, L: Leaves<C>>(
 ) -> bool {
     debug_assert!(isa.is_available());
     match isa {
-        // SAFETY: the portable kernel needs nothing beyond the target's baseline.
-        Isa::Portable => unsafe { traverse::any(Portable, nodes, depth, ray, limit, leaves, counters) },
+        Isa::Portable => portable::any(nodes, depth, ray, limit, leaves, counters),
         // SAFETY: the structure's instruction set is one the processor has (module documentation).
         #[cfg(target_arch = "x86_64")]
         Isa::Avx2 => unsafe { x86::any_avx2(nodes, depth, ray, limit, leaves, counters) },
@@ -61,6 +59,38 @@ pub fn any<C: Counters, L: Leaves<C>>(
         Isa::Avx512 => unsafe { x86::any_avx512(nodes, depth, ray, limit, leaves, counters) },
         #[cfg(not(target_arch = "x86_64"))]
         _ => unreachable!("x86 instruction sets are never available elsewhere"),
+    }
+}
+
+/// The portable copies, compiled apart like the others rather than inlined into every caller:
+/// inlined, their code and stack would weigh on the caller's registers and frame on machines that
+/// run another copy.
+mod portable {
+    use super::*;
+
+    #[inline(never)]
+    pub fn closest<C: Counters, L: Leaves<C>>(
+        nodes: &[WideNode],
+        depth: u32,
+        ray: &NodeRay,
+        leaves: &mut L,
+        counters: &mut C,
+    ) {
+        // SAFETY: the portable kernel needs nothing beyond the target's baseline.
+        unsafe { traverse::closest(Portable, nodes, depth, ray, leaves, counters) }
+    }
+
+    #[inline(never)]
+    pub fn any<C: Counters, L: Leaves<C>>(
+        nodes: &[WideNode],
+        depth: u32,
+        ray: &NodeRay,
+        limit: f32,
+        leaves: &mut L,
+        counters: &mut C,
+    ) -> bool {
+        // SAFETY: as above.
+        unsafe { traverse::any(Portable, nodes, depth, ray, limit, leaves, counters) }
     }
 }
 
