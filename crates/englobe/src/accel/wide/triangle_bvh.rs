@@ -276,7 +276,12 @@ impl TriangleBvh {
         filter: F,
     ) -> Option<Hit> {
         debug_assert!(ray.is_valid());
-        if self.nodes.is_empty() || !may_enter(&self.bounds, ray, reach(ray.t_max)) {
+        if self.nodes.is_empty() {
+            return None;
+        }
+        // The root's box first: a ray that passes beside it costs no more.
+        counters.box_tests(1);
+        if !may_enter(&self.bounds, ray, reach(ray.t_max)) {
             return None;
         }
         let mut leaves =
@@ -300,7 +305,12 @@ impl TriangleBvh {
         filter: F,
     ) -> bool {
         debug_assert!(ray.is_valid());
-        if self.nodes.is_empty() || !may_enter(&self.bounds, ray, reach(ray.t_max)) {
+        if self.nodes.is_empty() {
+            return false;
+        }
+        // The root's box first: a ray that passes beside it costs no more.
+        counters.box_tests(1);
+        if !may_enter(&self.bounds, ray, reach(ray.t_max)) {
             return false;
         }
         let mut leaves =
