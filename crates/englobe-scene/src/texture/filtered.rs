@@ -62,14 +62,16 @@ impl FilterPlan {
             return None;
         }
         let (major, long, short) = if ta >= tb { (a, ta, tb) } else { (b, tb, ta) };
-        let probes = if long <= short {
+        // A footprint within one texel is one probe: spreading probes inside a texel would only
+        // blur what the bilinear filter already shows.
+        let probes = if long <= short || 2.0 * long <= 1.0 {
             1
         } else if short > 0.0 {
             (long / short).ceil().min(MAX_ANISOTROPY as f32) as u32
         } else {
             MAX_ANISOTROPY
         };
-        let diameter = (2.0 * long / probes as f32).max(2.0 * short);
+        let diameter = if probes == 1 { 2.0 * long } else { (2.0 * long / probes as f32).max(2.0 * short) };
         Some(FilterPlan { probes, lod: diameter.log2(), step: major * (2.0 / probes as f32) })
     }
 }
