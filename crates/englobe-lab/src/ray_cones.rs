@@ -126,17 +126,7 @@ pub fn cone_table(rows: &[ConeRow]) -> String {
     let _ = writeln!(
         s,
         "\n{:<24} {:<16} {:>5} {:>10} {:>11} {:>13} {:>7} {:>6} {:>7} {:>12} {:>7}",
-        "scene",
-        "texture filter",
-        "spp",
-        "primary",
-        "rays",
-        "exact tests",
-        "s",
-        "RMSE",
-        "SSIM",
-        "uniform spp",
-        "fewer"
+        "scene", "texture filter", "spp", "primary", "rays", "exact tests", "s", "RMSE", "SSIM", "uniform spp", "fewer"
     );
     for r in rows {
         let (equivalent, ratio) = match (r.filter.as_str(), r.uniform_equivalent, r.ratio) {
@@ -161,4 +151,41 @@ pub fn cone_table(rows: &[ConeRow]) -> String {
         let _ = writeln!(s, "{}", line.trim_end());
     }
     s
+}
+
+#[cfg(test)]
+mod tests {
+    use englobe::AccelKind;
+
+    use super::*;
+    use crate::measure::{build, thread_pool};
+
+    #[test]
+    fn cones_cast_the_same_rays_for_less_error_on_the_textured_ground() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/textured-ground.toml");
+        let mut scene = englobe_scene::load_scene(&path).unwrap();
+        (scene.image.width, scene.image.height) = (64, 36);
+        let (world, _) = build(&scene, AccelKind::BvhWide).unwrap();
+        let pool = thread_pool(Some(2)).unwrap();
+        let rows = cone_rows("ground", &scene, &world, &pool, &mut |_| {}).unwrap();
+        assert_eq!(rows.len(), 1 + UNIFORM_SAMPLES.len() + CONE_SAMPLES.len());
+        let find =
+            |filter: &str, samples: u32| rows.iter().find(|r| r.filter == filter && r.samples == samples).unwrap();
+        for samples in CONE_SAMPLES {
+            let (cone, none) = (find("cone", samples), find("none", samples));
+            // The cone changes what a ray reads, not which rays are cast.
+            assert_eq!((cone.primary, cone.rays, cone.exact_tests), (none.primary, none.rays, none.exact_tests));
+            assert_eq!(cone.primary, 64 * 36 * samples as u64);
+            assert!(
+                cone.error.rmse < none.error.rmse,
+                "{samples} spp: {} against {}",
+                cone.error.rmse,
+                none.error.rmse
+            );
+        }
+        // One sample per pixel with cones is worth more than one without: the ratio says how much.
+        let one = find("cone", 1);
+        assert!(one.ratio.is_none_or(|r| r > 1.0), "{:?}", one.ratio);
+        assert!(cone_table(&rows).contains("fewer"));
+    }
 }

@@ -106,7 +106,8 @@ impl<'a> Whitted<'a> {
                     let factor = kt * (1.0 - f);
                     if worth(factor) {
                         let refracted = Ray::new(s.inside(), t_dir);
-                        color += self.trace(&refracted, RayKind::Refracted, depth + 1, weight * factor, cone, tally) * factor;
+                        color += self.trace(&refracted, RayKind::Refracted, depth + 1, weight * factor, cone, tally)
+                            * factor;
                     }
                 }
             }

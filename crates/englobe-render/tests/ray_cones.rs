@@ -24,7 +24,12 @@ fn checkerboard(distance: f32, texels: u32) -> Scene {
         .map(|i| if (i % texels + i / texels) % 2 == 0 { [255; 4] } else { [0, 0, 0, 255] })
         .collect();
     let image = Arc::new(TexelImage::from_rgba8(texels, texels, t).unwrap());
-    scene.textures.push(Arc::new(Texture::new("checker", TextureSource::Embedded("test".into()), Sampler::default(), image)));
+    scene.textures.push(Arc::new(Texture::new(
+        "checker",
+        TextureSource::Embedded("test".into()),
+        Sampler::default(),
+        image,
+    )));
     scene.materials.push(Material {
         diffuse: Vec3::ONE,
         textures: MaterialTextures { base_color: Some(TextureRef::new(0)), ..Default::default() },
@@ -93,7 +98,8 @@ fn the_path_tracer_filters_its_first_hits() {
     // Ambient is not used by the path tracer: the white background lights the board, so a
     // pixel is the albedo its first hit reads (its bounce escapes to the white sky): about one
     // half everywhere with cones, black or white or between without.
-    let contrast = |p: &[Vec3]| p.iter().map(|c| c.x).fold(0.0f32, f32::max) - p.iter().map(|c| c.x).fold(1.0, f32::min);
+    let contrast =
+        |p: &[Vec3]| p.iter().map(|c| c.x).fold(0.0f32, f32::max) - p.iter().map(|c| c.x).fold(1.0, f32::min);
     let (coned, point) = (render(&scene, TextureFilter::Cone), render(&scene, TextureFilter::None));
     assert!(contrast(&coned) < 0.5 * contrast(&point), "{} against {}", contrast(&coned), contrast(&point));
 }

@@ -153,7 +153,9 @@ mod tests {
     }
 
     fn reds(l: &MipLevel) -> Vec<f32> {
-        (0..l.height()).flat_map(|y| (0..l.width()).map(move |x| (l.fetch(x, y).x * 255.0 * 1000.0).round() / 1000.0)).collect()
+        (0..l.height())
+            .flat_map(|y| (0..l.width()).map(move |x| (l.fetch(x, y).x * 255.0 * 1000.0).round() / 1000.0))
+            .collect()
     }
 
     #[test]
