@@ -89,7 +89,7 @@ pub fn cone_rows(
     };
     let seed = scene.image.seed;
     progress(format!("{name}: texture filter none, {REFERENCE_SAMPLES} samples (reference)"));
-    let (reference, seconds) = render(TextureFilter::None, REFERENCE_SAMPLES, seed ^ 0x5eed_0f_c0e5)?;
+    let (reference, seconds) = render(TextureFilter::None, REFERENCE_SAMPLES, seed ^ 0x005e_ed0f_c0e5)?;
     let mut rows = vec![row(
         "none, reference",
         REFERENCE_SAMPLES,
