@@ -32,8 +32,8 @@ pub struct ExperimentArgs {
     /// Which experiment.
     #[arg(value_enum)]
     experiment: Experiment,
-    /// fewer-rays: the scene files (default: the seed's four tests, glass, mirrors and Sponza,
-    /// from the repository's `scenes/`).
+    /// fewer-rays: the scene files (default: the seed's four tests, glass, mirrors, Sponza, the
+    /// path-traced Cornell box and the textured ground, from the repository's `scenes/`).
     scenes: Vec<PathBuf>,
     /// fewer-rays: the adaptive-depth thresholds, comma-separated (default 0.1,0.03,0.01,0.003).
     #[arg(long, value_delimiter = ',')]

@@ -13,7 +13,9 @@
 //!
 //! On path-traced scenes (whose depth is a matter of Russian roulette, and whose noise would make
 //! every square look like an edge) a third: adaptive sampling to a noise threshold against uniform
-//! sampling, at equal error (see [`crate::fewer_samples`]).
+//! sampling, at equal error (see [`crate::fewer_samples`]). On textured Whitted scenes a fourth,
+//! the generalised rays: ray cones filtering the textures against point sampling, at equal error
+//! (see [`crate::ray_cones`]).
 
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -30,12 +32,13 @@ use crate::fewer_samples::{
 };
 use crate::image_error::{ImageError, image_error};
 use crate::measure::{build, thread_pool};
+use crate::ray_cones::{ConeRow, cone_rows, cone_table};
 use crate::report::grouped;
 
 /// The scenes measured by default, relative to the repository's root: the seed report's four
-/// tests, the glass and mirror scenes (where rays branch most), the Sponza, and the path-traced
-/// Cornell box.
-pub const DEFAULT_SCENES: [&str; 8] = [
+/// tests, the glass and mirror scenes (where rays branch most), the Sponza, the path-traced
+/// Cornell box, and a textured ground receding to the horizon (for the ray cones).
+pub const DEFAULT_SCENES: [&str; 9] = [
     "scenes/seed/test1.toml",
     "scenes/seed/test2.toml",
     "scenes/seed/test3.toml",
@@ -44,6 +47,7 @@ pub const DEFAULT_SCENES: [&str; 8] = [
     "scenes/mirrors.toml",
     "scenes/sponza.toml",
     "scenes/cornell-box-path.toml",
+    "scenes/textured-ground.toml",
 ];
 
 /// The adaptive-depth thresholds measured by default.
@@ -122,12 +126,14 @@ pub struct FewerRays {
     pub rows: Vec<FewerRaysRow>,
     /// Every render of a path-traced scene: adaptive sampling against uniform sampling.
     pub sampling: Vec<SamplingRow>,
+    /// Every render of a textured Whitted scene: ray cones against point-sampled textures.
+    pub cones: Vec<ConeRow>,
 }
 
 /// Runs the experiment; `progress` gets a line per render.
 pub fn run_fewer_rays(options: &FewerRaysOptions, progress: &mut dyn FnMut(String)) -> Result<FewerRays, LabError> {
     let pool = thread_pool(options.threads)?;
-    let mut out = FewerRays { rows: Vec::new(), sampling: Vec::new() };
+    let mut out = FewerRays { rows: Vec::new(), sampling: Vec::new(), cones: Vec::new() };
     for path in &options.scenes {
         let name = path.display().to_string();
         let mut scene = load_scene(path)?;
@@ -207,6 +213,9 @@ pub fn run_fewer_rays(options: &FewerRaysOptions, progress: &mut dyn FnMut(Strin
             let error = image_error(&image.film, &reference.film);
             out.rows.push(row("adaptive ss", format!("{contrast}/{max_level}"), &image.stats, seconds, error));
         }
+        if !scene.textures.is_empty() {
+            out.cones.extend(cone_rows(&name, &scene, &world, &pool, progress)?);
+        }
     }
     Ok(out)
 }
@@ -216,7 +225,7 @@ impl FewerRays {
     pub fn table(&self) -> String {
         let mut s = String::new();
         if self.rows.is_empty() {
-            return sampling_table(&self.sampling).trim_start().to_owned();
+            return (sampling_table(&self.sampling) + &cone_table(&self.cones)).trim_start().to_owned();
         }
         let _ = writeln!(
             s,
@@ -251,6 +260,7 @@ impl FewerRays {
             );
         }
         s += &sampling_table(&self.sampling);
+        s += &cone_table(&self.cones);
         s
     }
 }

@@ -2,7 +2,8 @@
 //!
 //! englobe's research, as a library: the seed report's experiment ([`seed_experiment`], on the
 //! scenes and figures of [`seed_report`]), its other family of speed-ups, fewer rays
-//! ([`fewer_rays`], and [`fewer_samples`] for the path tracer's adaptive sampling, with
+//! ([`fewer_rays`], [`fewer_samples`] for the path tracer's adaptive sampling and [`ray_cones`]
+//! for texture filtering by ray cones, with
 //! [`image_error`] saying what an image loses) and the comparison of every acceleration structure on one
 //! scene ([`compare`]), both built on [`measure`] (build, render, time, compare images); their
 //! reports ([`report`]: tables and JSON; [`html_report`]: the comparison and the seed experiment, each
@@ -31,6 +32,7 @@ pub mod image_error;
 pub mod measure;
 pub mod memory;
 pub mod plot;
+pub mod ray_cones;
 pub mod report;
 pub mod seed_experiment;
 pub mod seed_report;

@@ -28,6 +28,7 @@ use crate::bsdf::{Bsdf, Frame, SampleKind};
 use crate::emitters::{Emitters, power_heuristic};
 use crate::light_sampling::SampledLights;
 use crate::optics::{fresnel_dielectric, reflect, refract};
+use crate::ray_cone::RayCone;
 use crate::sampling::cosine_hemisphere;
 use crate::shading::{SHADOW_RAY_END, Surface};
 use crate::stats::{RayKind, Tally};
@@ -43,6 +44,7 @@ pub struct PathTracer<'a> {
     vis: Visibility<'a>,
     emitters: Emitters,
     lights: SampledLights,
+    cone: Option<RayCone>,
 }
 
 /// Where a path goes from a hit: the next ray, its kind, the factor on the throughput and the
@@ -63,7 +65,16 @@ impl<'a> PathTracer<'a> {
             vis: Visibility::new(scene, world),
             emitters: Emitters::of(scene),
             lights: SampledLights::of(scene),
+            cone: None,
         }
+    }
+
+    /// The integrator with textures read over the footprint of the primary rays' cone `cone`
+    /// (see [`crate::ray_cone`]; `None`: at the hit points). Only the first hit is filtered: a
+    /// diffuse bounce's cone would cover whole objects.
+    pub fn with_cone(mut self, cone: Option<RayCone>) -> Self {
+        self.cone = cone;
+        self
     }
 
     /// True if the hit lies on a triangle, which [`Emitters`] samples when it emits.
@@ -230,7 +241,8 @@ impl<'a> PathTracer<'a> {
                 radiance += throughput * self.lights.escaped(ray.dir(), bounce_pdf, self.scene.image.background);
                 break;
             };
-            let s = Surface::at(self.scene, self.world, &ray, &hit);
+            let cone = if depth == 0 { self.cone } else { None };
+            let s = Surface::at_over(self.scene, self.world, &ray, &hit, cone);
             // Surfaces emit from their front side only (outward normal, or the winding's normal),
             // as physical lamps do.
             let emission = s.params.emission;

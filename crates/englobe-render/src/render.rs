@@ -13,7 +13,7 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::time::Instant;
 
 use englobe::{Counters, NoCount, Vec3, WorkCounts, World};
-use englobe_scene::{ImageSettings, IntegratorKind, Scene};
+use englobe_scene::{ImageSettings, IntegratorKind, Scene, TextureFilter};
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg32;
 use rayon::prelude::*;
@@ -23,6 +23,7 @@ use crate::cost::CostImage;
 use crate::film::Film;
 use crate::filter::FilterSampler;
 use crate::path::PathTracer;
+use crate::ray_cone::RayCone;
 use crate::stats::{RenderStats, Tally};
 use crate::supersample::AdaptiveSupersampling;
 use crate::tile::PixelWindow;
@@ -366,9 +367,12 @@ impl<'a> Renderer<'a> {
     /// The camera and the integrator of a render.
     pub(crate) fn parts(&self) -> (ImageCamera, Integrator<'a>) {
         let camera = ImageCamera::new(&self.scene.camera, self.width, self.height);
+        // Untextured scenes skip the cones: they would change nothing but the time.
+        let cone = (self.scene.image.texture_filter == TextureFilter::Cone && !self.scene.textures.is_empty())
+            .then(|| RayCone::primary(&self.scene.camera, self.height, self.samples));
         let integrator = match self.integrator {
-            IntegratorKind::Whitted => Integrator::Whitted(Whitted::new(self.scene, self.world)),
-            IntegratorKind::Path => Integrator::Path(PathTracer::new(self.scene, self.world)),
+            IntegratorKind::Whitted => Integrator::Whitted(Whitted::new(self.scene, self.world).with_cone(cone)),
+            IntegratorKind::Path => Integrator::Path(PathTracer::new(self.scene, self.world).with_cone(cone)),
         };
         (camera, integrator)
     }

@@ -13,6 +13,7 @@ use englobe::{Counters, Object, Ray, Vec3, World, WorldHit};
 use englobe_scene::{Light, Material, MaterialModel, Scene, SurfaceParams};
 
 use crate::optics::offset_ray_origin;
+use crate::ray_cone::{RayCone, footprint};
 use crate::stats::{RayKind, Tally};
 use crate::visibility::Visibility;
 
@@ -42,6 +43,12 @@ impl<'a> Surface<'a> {
     /// coordinate, the shading normal bent by its normal map (in the frame of the mesh's tangents,
     /// moved into the world by an instance's transform).
     pub fn at(scene: &'a Scene, world: &World, ray: &Ray, hit: &WorldHit) -> Self {
+        Self::at_over(scene, world, ray, hit, None)
+    }
+
+    /// [`Surface::at`] with the textures read over the footprint of `cone`, the ray's cone (see
+    /// [`crate::ray_cone`]); `None` reads them at the hit point.
+    pub fn at_over(scene: &'a Scene, world: &World, ray: &Ray, hit: &WorldHit, cone: Option<RayCone>) -> Self {
         let object = &scene.objects[hit.object as usize];
         let material = &scene.materials[object.material_of(hit.prim) as usize];
         let p = world.hit_point(ray, hit);
@@ -50,7 +57,11 @@ impl<'a> Surface<'a> {
         let entering = d.dot(geometric) < 0.0;
         let n = if entering { geometric } else { -geometric };
         let uv = if material.textures.is_empty() { None } else { object.uv(hit.prim, hit.u, hit.v) };
-        let params = material.evaluate(&scene.textures, uv);
+        let area = match (cone, uv) {
+            (Some(c), Some(_)) => footprint(object, hit.prim, d, c.width_at((p - ray.origin()).length())),
+            _ => None,
+        };
+        let params = material.evaluate_over(&scene.textures, uv, area);
         let mut shading = world.shading_normal(hit, p);
         if let (Some(bent), Some(tangent)) = (params.normal_ts, object.tangent(hit.prim, hit.u, hit.v)) {
             let (t, w) = match &world.objects()[hit.object as usize] {

@@ -19,13 +19,16 @@
 //! of at one fixed depth for every path.
 //!
 //! Textures shade it as they shade the path tracer (base colour, highlight colour, emission, normal
-//! maps, cut-outs); a metallic-roughness material reaches it as its diffuse base colour.
+//! maps, cut-outs); a metallic-roughness material reaches it as its diffuse base colour. With the
+//! scene's `texture_filter = "cone"`, every ray carries a cone (see [`crate::ray_cone`]) that
+//! its reflections and refractions continue, and textures are read over its footprint.
 
 use englobe::{Counters, Ray, Vec3, World};
 use englobe_scene::Scene;
 
 use crate::environment::EnvironmentLight;
 use crate::optics::{fresnel_dielectric, reflect, refract};
+use crate::ray_cone::RayCone;
 use crate::shading::Surface;
 use crate::stats::{RayKind, Tally};
 use crate::visibility::Visibility;
@@ -36,6 +39,7 @@ pub struct Whitted<'a> {
     world: &'a World,
     vis: Visibility<'a>,
     environment: Option<EnvironmentLight>,
+    cone: Option<RayCone>,
 }
 
 impl<'a> Whitted<'a> {
@@ -46,22 +50,39 @@ impl<'a> Whitted<'a> {
             world,
             vis: Visibility::new(scene, world),
             environment: scene.environment.as_ref().map(EnvironmentLight::new),
+            cone: None,
         }
+    }
+
+    /// The integrator with textures read over the footprints of ray cones, `cone` being the
+    /// primary rays' (`None`: at the hit points).
+    pub fn with_cone(mut self, cone: Option<RayCone>) -> Self {
+        self.cone = cone;
+        self
     }
 
     /// The colour seen along a primary `ray`.
     pub fn radiance<C: Counters>(&self, ray: &Ray, tally: &mut Tally<C>) -> Vec3 {
-        self.trace(ray, RayKind::Primary, 0, 1.0, tally)
+        self.trace(ray, RayKind::Primary, 0, 1.0, self.cone, tally)
     }
 
     /// The colour seen along `ray`, a ray of `kind` at recursion `depth` (0 for primary rays)
-    /// whose colour reaches the pixel multiplied by `weight`.
-    fn trace<C: Counters>(&self, ray: &Ray, kind: RayKind, depth: u32, weight: f32, tally: &mut Tally<C>) -> Vec3 {
+    /// whose colour reaches the pixel multiplied by `weight`, and whose cone is `cone`.
+    #[allow(clippy::too_many_arguments)]
+    fn trace<C: Counters>(
+        &self,
+        ray: &Ray,
+        kind: RayKind,
+        depth: u32,
+        weight: f32,
+        cone: Option<RayCone>,
+        tally: &mut Tally<C>,
+    ) -> Vec3 {
         tally.rays[kind as usize] += 1;
         let Some(hit) = self.vis.closest_hit(ray, &mut tally.work[kind as usize]) else {
             return self.environment.as_ref().map_or(self.scene.image.background, |e| e.radiance(ray.dir()));
         };
-        let s = Surface::at(self.scene, self.world, ray, &hit);
+        let s = Surface::at_over(self.scene, self.world, ray, &hit, cone);
         let m = s.material;
         let (kr, kt) = (m.reflectivity, m.transparency);
         let (lit, highlight) = s.direct_light(self.scene, &self.vis, tally);
@@ -72,6 +93,7 @@ impl<'a> Whitted<'a> {
             return color;
         }
         let worth = |factor: f32| weight * factor >= self.scene.image.min_contribution;
+        let cone = cone.map(|c| c.continued((s.p - ray.origin()).length()));
         let mut mirror_weight = kr;
         if kt > 0.0 {
             let eta = if s.entering { 1.0 / m.ior } else { m.ior };
@@ -84,15 +106,16 @@ impl<'a> Whitted<'a> {
                     let factor = kt * (1.0 - f);
                     if worth(factor) {
                         let refracted = Ray::new(s.inside(), t_dir);
-                        color += self.trace(&refracted, RayKind::Refracted, depth + 1, weight * factor, tally) * factor;
+                        color += self.trace(&refracted, RayKind::Refracted, depth + 1, weight * factor, cone, tally)
+                            * factor;
                     }
                 }
             }
         }
         if mirror_weight > 0.0 && worth(mirror_weight) {
             let reflected = Ray::new(s.outside(), reflect(s.d, s.n));
-            color +=
-                self.trace(&reflected, RayKind::Reflected, depth + 1, weight * mirror_weight, tally) * mirror_weight;
+            let seen = self.trace(&reflected, RayKind::Reflected, depth + 1, weight * mirror_weight, cone, tally);
+            color += seen * mirror_weight;
         }
         color
     }

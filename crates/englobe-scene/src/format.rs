@@ -74,6 +74,8 @@ pub struct ImageDef {
     pub filter: Option<Spanned<String>>,
     pub filter_radius: Option<Spanned<FilterRadius>>,
     pub filter_sigma: Option<Spanned<Positive>>,
+    #[serde(default)]
+    pub texture_filter: crate::model::TextureFilter,
 }
 
 /// A filter radius: one number for both axes, or `[x, y]`.

@@ -21,7 +21,7 @@ use glam::{Vec2, Vec3, Vec4};
 use crate::material::{
     AlphaMode, Channel, Material, MaterialModel, NormalEncoding, ScalarTexture, TextureRef, shininess_to_roughness,
 };
-use crate::texture::{ColorSpace, Texture};
+use crate::texture::{ColorSpace, Texture, UvFootprint};
 
 /// Base colour shown where a base colour texture could not be read.
 pub const MISSING_TEXTURE_COLOR: Vec3 = Vec3::new(1.0, 0.0, 1.0);
@@ -67,9 +67,20 @@ pub struct SurfaceParams {
     pub occlusion: f32,
 }
 
-fn lookup(textures: &[Arc<Texture>], r: &TextureRef, uv: Vec2, space: ColorSpace) -> Option<Vec4> {
-    let uv = r.transform.map_or(uv, |t| t.apply(uv));
-    textures.get(r.texture as usize)?.sample(uv, space)
+/// The texture of `r` at `uv`, over `footprint` when there is one (moved by the texture
+/// transform's linear part, as the coordinates are).
+fn lookup_over(
+    textures: &[Arc<Texture>],
+    r: &TextureRef,
+    uv: Vec2,
+    footprint: Option<UvFootprint>,
+    space: ColorSpace,
+) -> Option<Vec4> {
+    let (uv, footprint) = match r.transform {
+        None => (uv, footprint),
+        Some(t) => (t.apply(uv), footprint.map(|f| f.mapped(|a| t.apply(a) - t.apply(Vec2::ZERO)))),
+    };
+    textures.get(r.texture as usize)?.sample_over(uv, footprint, space)
 }
 
 fn channel(v: Vec4, c: Channel) -> f32 {
@@ -82,8 +93,8 @@ fn channel(v: Vec4, c: Channel) -> f32 {
     }
 }
 
-fn scalar(textures: &[Arc<Texture>], s: &ScalarTexture, uv: Vec2) -> Option<f32> {
-    let v = channel(lookup(textures, &s.texture, uv, ColorSpace::Linear)?, s.channel);
+fn scalar(textures: &[Arc<Texture>], s: &ScalarTexture, uv: Vec2, footprint: Option<UvFootprint>) -> Option<f32> {
+    let v = channel(lookup_over(textures, &s.texture, uv, footprint, ColorSpace::Linear)?, s.channel);
     Some(s.remap.map_or(v, |[base, gain]| base + gain * v))
 }
 
@@ -91,10 +102,22 @@ impl Material {
     /// The surface parameters at texture coordinate `uv` (set 0, glTF convention; `None` when
     /// the mesh has none, which leaves the factors alone), reading `textures` (the scene's).
     pub fn evaluate(&self, textures: &[Arc<Texture>], uv: Option<Vec2>) -> SurfaceParams {
+        self.evaluate_over(textures, uv, None)
+    }
+
+    /// [`Material::evaluate`] with every texture read over `footprint` around `uv` (a ray
+    /// cone's, see [`crate::texture::sample_footprint`]); `None` reads them at the point, exactly
+    /// as `evaluate` does.
+    pub fn evaluate_over(
+        &self,
+        textures: &[Arc<Texture>],
+        uv: Option<Vec2>,
+        footprint: Option<UvFootprint>,
+    ) -> SurfaceParams {
         let t = &self.textures;
         let sample = |r: &Option<TextureRef>, space| -> Option<Option<Vec4>> {
             let (r, uv) = (r.as_ref()?, uv?);
-            Some(lookup(textures, r, uv, space))
+            Some(lookup_over(textures, r, uv, footprint, space))
         };
         // Some(None): the slot has a texture that could not be read.
         let base = sample(&t.base_color, ColorSpace::Srgb);
@@ -124,12 +147,12 @@ impl Material {
             }
         };
         let normal_ts = match (t.normal, uv) {
-            (Some(n), Some(uv)) => self.normal_from_map(textures, &n, uv),
+            (Some(n), Some(uv)) => self.normal_from_map(textures, &n, uv, footprint),
             _ => None,
         };
         SurfaceParams {
             base_color,
-            alpha: self.alpha_at(textures, uv, base),
+            alpha: self.alpha_at(textures, uv, base, footprint),
             metallic: metallic.clamp(0.0, 1.0),
             roughness: roughness.clamp(0.0, 1.0),
             transmission: transmission.clamp(0.0, 1.0),
@@ -138,7 +161,7 @@ impl Material {
             normal_ts,
             specular,
             occlusion: match (&t.occlusion, uv) {
-                (Some(o), Some(uv)) => scalar(textures, o, uv).unwrap_or(1.0).clamp(0.0, 1.0),
+                (Some(o), Some(uv)) => scalar(textures, o, uv, footprint).unwrap_or(1.0).clamp(0.0, 1.0),
                 _ => 1.0,
             },
         }
@@ -146,20 +169,26 @@ impl Material {
 
     /// The alpha at `uv`: the factor times the alpha texture's value when there is one (MTL),
     /// else times the base colour texture's alpha (glTF). `base` is the base colour sample when
-    /// the caller already has it.
-    fn alpha_at(&self, textures: &[Arc<Texture>], uv: Option<Vec2>, base: Option<Option<Vec4>>) -> f32 {
+    /// the caller already has it; `footprint` is the lookups' (see [`Material::evaluate_over`]).
+    fn alpha_at(
+        &self,
+        textures: &[Arc<Texture>],
+        uv: Option<Vec2>,
+        base: Option<Option<Vec4>>,
+        footprint: Option<UvFootprint>,
+    ) -> f32 {
         if self.alpha.mode == AlphaMode::Opaque {
             return 1.0;
         }
         let texture = match (&self.textures.alpha, uv) {
-            (Some(a), Some(uv)) => scalar(textures, a, uv),
+            (Some(a), Some(uv)) => scalar(textures, a, uv, footprint),
             (None, Some(uv)) => match base {
                 Some(b) => b.map(|c| c.w),
                 None => self
                     .textures
                     .base_color
                     .as_ref()
-                    .and_then(|r| lookup(textures, r, uv, ColorSpace::Linear))
+                    .and_then(|r| lookup_over(textures, r, uv, footprint, ColorSpace::Linear))
                     .map(|c| c.w),
             },
             _ => None,
@@ -173,13 +202,13 @@ impl Material {
         match self.alpha.mode {
             AlphaMode::Opaque => 1.0,
             AlphaMode::Mask { cutoff } => {
-                if self.alpha_at(textures, uv, None) >= cutoff {
+                if self.alpha_at(textures, uv, None, None) >= cutoff {
                     1.0
                 } else {
                     0.0
                 }
             }
-            AlphaMode::Blend => self.alpha_at(textures, uv, None),
+            AlphaMode::Blend => self.alpha_at(textures, uv, None, None),
         }
     }
 
@@ -197,10 +226,18 @@ impl Material {
         self.alpha.mode != AlphaMode::Opaque && self.coverage(textures, uv) <= 0.0
     }
 
-    fn normal_from_map(&self, textures: &[Arc<Texture>], n: &crate::material::NormalMap, uv: Vec2) -> Option<Vec3> {
+    fn normal_from_map(
+        &self,
+        textures: &[Arc<Texture>],
+        n: &crate::material::NormalMap,
+        uv: Vec2,
+        footprint: Option<UvFootprint>,
+    ) -> Option<Vec3> {
         match n.encoding {
+            // A filtered normal map averages normals; the average is shorter than one where
+            // they disagree, and is normalised like any other.
             NormalEncoding::TangentSpace => {
-                let c = lookup(textures, &n.texture, uv, ColorSpace::Linear)?.truncate();
+                let c = lookup_over(textures, &n.texture, uv, footprint, ColorSpace::Linear)?.truncate();
                 ((c * 2.0 - Vec3::ONE) * Vec3::new(n.scale, n.scale, 1.0)).try_normalize()
             }
             NormalEncoding::Height(ch) => {

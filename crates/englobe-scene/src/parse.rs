@@ -264,6 +264,7 @@ impl Converter<'_> {
             clamp: i.clamp.map(|c| c.0),
             output: crate::model::OutputSettings { exposure, tonemap: i.tonemap, exr_half: i.exr_half },
             filter,
+            texture_filter: i.texture_filter,
         })
     }
 

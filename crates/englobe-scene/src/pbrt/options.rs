@@ -78,6 +78,7 @@ impl Builder {
             output: Default::default(),
             noise_threshold: 0.0,
             min_samples: None,
+            texture_filter: Default::default(),
         };
         Ok((image, camera))
     }

@@ -1,8 +1,9 @@
 //! How a texture is read between and beyond its texels: the glTF 2.0 sampler (section 3.8.4,
 //! "Samplers"). Wrap modes per axis (repeat, mirrored repeat, clamp to edge, with the meanings
 //! OpenGL gives them), and bilinear or nearest filtering with texel centres at
-//! `((i + 0.5) / width, (j + 0.5) / height)`. Mipmaps are not built: minification filters of
-//! the file are read as bilinear.
+//! `((i + 0.5) / width, (j + 0.5) / height)`. The same bilinear filter reads the levels of a mip
+//! pyramid (see [`super::filtered`]), through [`Grid`]; without a footprint (the scene's
+//! `texture_filter = "none"`), minification filters of the file are read as bilinear.
 
 use glam::{Vec2, Vec4};
 
@@ -57,6 +58,25 @@ impl Wrap {
     }
 }
 
+/// A grid of texels that a sampler reads: an image in one colour space, or a mip level.
+pub(crate) trait Grid {
+    /// Width and height in texels.
+    fn size(&self) -> (u32, u32);
+    /// Texel `(x, y)` as linear RGBA; `x` and `y` inside the grid.
+    fn texel(&self, x: u32, y: u32) -> Vec4;
+}
+
+impl Grid for (&TexelImage, ColorSpace) {
+    #[inline]
+    fn size(&self) -> (u32, u32) {
+        (self.0.width(), self.0.height())
+    }
+    #[inline]
+    fn texel(&self, x: u32, y: u32) -> Vec4 {
+        self.0.fetch(x, y, self.1)
+    }
+}
+
 impl Sampler {
     /// A sampler with one wrap mode on both axes and bilinear filtering.
     pub fn wrapping(wrap: Wrap) -> Self {
@@ -66,18 +86,24 @@ impl Sampler {
     /// The filtered value of `image` at `uv` (see the module's conventions), linear RGBA.
     /// Coordinates that are not finite read texel `(0, 0)`.
     pub fn sample(&self, image: &TexelImage, uv: Vec2, space: ColorSpace) -> Vec4 {
-        let (w, h) = (image.width(), image.height());
+        self.sample_grid(&(image, space), uv, self.filter)
+    }
+
+    /// The value of `grid` at `uv` through `filter`, with this sampler's wrap modes.
+    #[inline]
+    pub(crate) fn sample_grid<G: Grid>(&self, grid: &G, uv: Vec2, filter: Filter) -> Vec4 {
+        let (w, h) = grid.size();
         let uv = if uv.is_finite() { uv } else { Vec2::ZERO };
         // Far outside the image, f32 loses the fraction; keep the coordinates where i64 and f32
         // agree (the wrap is periodic, so this changes nothing for repeating modes within the
         // precision left, and clamping is unaffected).
         let x = (uv.x as f64 * w as f64).clamp(-1e15, 1e15);
         let y = (uv.y as f64 * h as f64).clamp(-1e15, 1e15);
-        match self.filter {
+        match filter {
             Filter::Nearest => {
                 let i = self.wrap_u.index(x.floor() as i64, w);
                 let j = self.wrap_v.index(y.floor() as i64, h);
-                image.fetch(i, j, space)
+                grid.texel(i, j)
             }
             Filter::Bilinear => {
                 let (x, y) = (x - 0.5, y - 0.5);
@@ -86,8 +112,8 @@ impl Sampler {
                 let (x0, y0) = (x0 as i64, y0 as i64);
                 let (i0, i1) = (self.wrap_u.index(x0, w), self.wrap_u.index(x0 + 1, w));
                 let (j0, j1) = (self.wrap_v.index(y0, h), self.wrap_v.index(y0 + 1, h));
-                let top = image.fetch(i0, j0, space).lerp(image.fetch(i1, j0, space), fx);
-                let bottom = image.fetch(i0, j1, space).lerp(image.fetch(i1, j1, space), fx);
+                let top = grid.texel(i0, j0).lerp(grid.texel(i1, j0), fx);
+                let bottom = grid.texel(i0, j1).lerp(grid.texel(i1, j1), fx);
                 top.lerp(bottom, fy)
             }
         }

@@ -8,7 +8,9 @@ use std::sync::Arc;
 
 use glam::{Vec2, Vec4};
 
+use super::filtered::{UvFootprint, sample_footprint};
 use super::image::{ColorSpace, TexelImage};
+use super::mip::MipCache;
 use super::sampler::Sampler;
 
 /// Index into [`crate::Scene::textures`] (or, in a [`crate::mesh::LoadedMesh`], into its own
@@ -48,17 +50,19 @@ pub struct Texture {
     pub image: Option<Arc<TexelImage>>,
     /// Why the image could not be read.
     pub error: Option<String>,
+    /// The image's mip pyramids, built when a footprint first needs them.
+    pub mips: MipCache,
 }
 
 impl Texture {
     /// A readable texture.
     pub fn new(name: impl Into<String>, source: TextureSource, sampler: Sampler, image: Arc<TexelImage>) -> Self {
-        Texture { name: name.into(), source, sampler, image: Some(image), error: None }
+        Texture { name: name.into(), source, sampler, image: Some(image), error: None, mips: MipCache::default() }
     }
 
     /// A texture whose image could not be read, and why.
     pub fn unreadable(name: impl Into<String>, source: TextureSource, sampler: Sampler, error: String) -> Self {
-        Texture { name: name.into(), source, sampler, image: None, error: Some(error) }
+        Texture { name: name.into(), source, sampler, image: None, error: Some(error), mips: MipCache::default() }
     }
 
     /// The filtered value at `uv` (glTF convention: `(0, 0)` the image's top-left corner, `v`
@@ -67,6 +71,17 @@ impl Texture {
     #[inline]
     pub fn sample(&self, uv: Vec2, space: ColorSpace) -> Option<Vec4> {
         self.image.as_ref().map(|image| self.sampler.sample(image, uv, space))
+    }
+
+    /// The value over `footprint` centred at `uv` (see [`super::filtered`]); without a
+    /// footprint, [`Texture::sample`]. `None` when the image could not be read.
+    #[inline]
+    pub fn sample_over(&self, uv: Vec2, footprint: Option<UvFootprint>, space: ColorSpace) -> Option<Vec4> {
+        let image = self.image.as_ref()?;
+        Some(match footprint {
+            None => self.sampler.sample(image, uv, space),
+            Some(f) => sample_footprint(&self.sampler, image, || self.mips.get(image, space), uv, f, space),
+        })
     }
 
     /// `width x height` for people, or `unreadable`.
