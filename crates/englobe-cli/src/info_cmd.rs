@@ -97,6 +97,11 @@ fn material_text(m: &Material, textures: &[std::sync::Arc<Texture>]) -> String {
             "metallic_roughness, base colour {}, metallic {metallic}, roughness {roughness}, transmission {transmission}, ior {}",
             m.diffuse, m.ior
         ),
+        MaterialModel::Conductor { eta, k, alpha } => format!("conductor, eta {eta}, k {k}, alpha {alpha}"),
+        MaterialModel::Dielectric { alpha } => format!("dielectric, ior {}, alpha {alpha}", m.ior),
+        MaterialModel::CoatedDiffuse { alpha } => {
+            format!("coated_diffuse, reflectance {}, coat ior {}, alpha {alpha}", m.diffuse, m.ior)
+        }
     };
     if m.emission != englobe::Vec3::ZERO {
         let _ = write!(s, ", emission {}", m.emission);

@@ -24,7 +24,7 @@ use englobe_scene::{MaterialModel, Scene};
 use rand::RngExt;
 use rand_pcg::Pcg32;
 
-use crate::bsdf::{Bsdf, Frame, SampleKind};
+use crate::bsdf::{Bsdf, Frame, SampleKind, TrowbridgeReitz};
 use crate::emitters::{Emitters, power_heuristic};
 use crate::light_sampling::SampledLights;
 use crate::optics::{fresnel_dielectric, reflect, refract};
@@ -109,7 +109,7 @@ impl<'a> PathTracer<'a> {
         f_cos * e.emission * (power_heuristic(pdf_light, pdf_bounce) / pdf_light)
     }
 
-    /// A microfacet surface (glTF's metallic-roughness model, see [`crate::bsdf`]): light from
+    /// A surface with a BSDF ([`surface_bsdf`], see [`crate::bsdf`]): light from
     /// the point and directional lights and from the emitters, added to `radiance`, and where the
     /// path goes on, drawn from the BSDF.
     fn scatter_microfacet<C: Counters>(
@@ -120,8 +120,7 @@ impl<'a> PathTracer<'a> {
         throughput: Vec3,
         radiance: &mut Vec3,
     ) -> Option<Scatter> {
-        let p = &s.params;
-        let bsdf = Bsdf::metallic_roughness(p.base_color, p.metallic, p.roughness, p.transmission, p.ior);
+        let bsdf = surface_bsdf(s);
         // The frame of a transmitting BSDF must face outward; the others are two-sided.
         let frame = Frame::from_z(if s.entering { s.ns } else { -s.ns });
         let wo = frame.to_local(-s.d);
@@ -250,9 +249,7 @@ impl<'a> PathTracer<'a> {
             }
             let next = match s.material.model {
                 MaterialModel::Classic => self.scatter_classic(&s, rng, tally, throughput, &mut radiance),
-                MaterialModel::MetallicRoughness { .. } => {
-                    self.scatter_microfacet(&s, rng, tally, throughput, &mut radiance)
-                }
+                _ => self.scatter_microfacet(&s, rng, tally, throughput, &mut radiance),
             };
             let Some(next) = next else { break };
             throughput *= next.weight;
@@ -266,5 +263,17 @@ impl<'a> PathTracer<'a> {
             }
         }
         radiance
+    }
+}
+
+/// The BSDF of a surface whose material is not classic: glTF's metallic-roughness model, or
+/// pbrt-v4's conductor, dielectric and coated diffuse (see `englobe_scene::MaterialModel`).
+fn surface_bsdf(s: &Surface) -> Bsdf {
+    let p = &s.params;
+    match s.material.model {
+        MaterialModel::Conductor { eta, k, alpha } => Bsdf::conductor(eta, k, TrowbridgeReitz::isotropic(alpha)),
+        MaterialModel::Dielectric { alpha } => Bsdf::dielectric(p.ior, TrowbridgeReitz::isotropic(alpha)),
+        MaterialModel::CoatedDiffuse { alpha } => Bsdf::plastic(p.base_color, alpha, p.ior),
+        _ => Bsdf::metallic_roughness(p.base_color, p.metallic, p.roughness, p.transmission, p.ior),
     }
 }
