@@ -32,6 +32,7 @@ pub mod output;
 mod passes;
 pub mod path;
 pub mod render;
+pub mod sampler;
 pub mod sampling;
 pub mod shading;
 pub mod sphere_lights;

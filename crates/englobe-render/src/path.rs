@@ -21,8 +21,7 @@ use std::f32::consts::PI;
 
 use englobe::{Counters, Object, Ray, Shape, Vec2, Vec3, World, WorldHit};
 use englobe_scene::{MaterialModel, Scene};
-use rand::RngExt;
-use rand_pcg::Pcg32;
+use rand::{Rng, RngExt};
 
 use crate::bsdf::{Bsdf, Frame, SampleKind, TrowbridgeReitz};
 use crate::emitters::{Emitters, power_heuristic};
@@ -81,7 +80,7 @@ impl<'a> PathTracer<'a> {
     fn sample_emitters<C: Counters>(
         &self,
         s: &Surface,
-        rng: &mut Pcg32,
+        rng: &mut impl Rng,
         tally: &mut Tally<C>,
         bsdf: impl Fn(Vec3) -> (Vec3, f32),
     ) -> Vec3 {
@@ -115,7 +114,7 @@ impl<'a> PathTracer<'a> {
     fn scatter_microfacet<C: Counters>(
         &self,
         s: &Surface,
-        rng: &mut Pcg32,
+        rng: &mut impl Rng,
         tally: &mut Tally<C>,
         throughput: Vec3,
         radiance: &mut Vec3,
@@ -162,7 +161,7 @@ impl<'a> PathTracer<'a> {
     fn scatter_classic<C: Counters>(
         &self,
         s: &Surface,
-        rng: &mut Pcg32,
+        rng: &mut impl Rng,
         tally: &mut Tally<C>,
         throughput: Vec3,
         radiance: &mut Vec3,
@@ -216,7 +215,7 @@ impl<'a> PathTracer<'a> {
     }
 
     /// One estimate of the radiance along the primary ray `ray`.
-    pub fn radiance<C: Counters>(&self, ray: &Ray, rng: &mut Pcg32, tally: &mut Tally<C>) -> Vec3 {
+    pub fn radiance<C: Counters>(&self, ray: &Ray, rng: &mut impl Rng, tally: &mut Tally<C>) -> Vec3 {
         let mut radiance = Vec3::ZERO;
         let mut throughput = Vec3::ONE;
         let mut ray = *ray;
