@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use englobe::{Object, Vec2, Vec3};
 use englobe_scene::pbrt::{is_pbrt_path, load, parse};
 use englobe_scene::shared_data::locate_shared;
-use englobe_scene::{Light, MaterialModel, PixelFilter, Scene, SceneError};
+use englobe_scene::{Light, MaterialModel, PixelFilter, SamplerKind, Scene, SceneError};
 
 fn shared_scenes() -> PathBuf {
     let here = Path::new(env!("CARGO_MANIFEST_DIR"));
@@ -79,8 +79,10 @@ fn the_cornell_box_reads_as_its_readme_says() {
     let red = s.objects.iter().find(|o| s.material_names[o.material as usize] == "LeftWall").unwrap();
     let Object::Mesh(wall) = &red.object else { panic!() };
     assert!(wall.positions().iter().all(|p| (p.x + 1.0).abs() < 1e-6));
-    // Only what does not change the picture is reported: the film's file name and the sampler.
-    assert_eq!(s.warnings.len(), 2, "{:?}", s.warnings);
+    // Only what does not change the picture is reported: the film's file name (its "sobol"
+    // sampler is englobe's Sobol sampler).
+    assert_eq!(s.image.sampler, englobe_scene::SamplerKind::Sobol);
+    assert_eq!(s.warnings.len(), 1, "{:?}", s.warnings);
     assert!(s.warnings.iter().all(|w| w.contains(": ignored: ")), "{:?}", s.warnings);
     assert!(s.warnings[0].contains("scene-v4.pbrt:10:5") && s.warnings[0].contains("cornell-box.png"));
 }
@@ -261,6 +263,26 @@ fn materials_map_to_their_bsdfs_and_say_what_is_approximated() {
     for exact in ["glass", "frosted", "chrome", "raw"] {
         assert!(!said(exact, ""), "{exact} is rendered as pbrt defines it: {:?}", s.warnings);
     }
+}
+
+#[test]
+fn samplers_follow_the_sampler_directive() {
+    let with = |sampler: &str| scene(&format!("{sampler}\nWorldBegin\nShape \"sphere\"\n"));
+    // pbrt-v4's default is zsobol: a low-discrepancy sampler, as englobe's Sobol one.
+    assert_eq!(with("").image.sampler, SamplerKind::Sobol);
+    assert_eq!(with("Sampler \"zsobol\"").image.sampler, SamplerKind::Sobol);
+    let independent = with("Sampler \"independent\" \"integer pixelsamples\" 4 \"integer seed\" 7");
+    assert_eq!(
+        (independent.image.sampler, independent.image.samples, independent.image.seed),
+        (SamplerKind::Independent, 4, 7)
+    );
+    let halton = with("Sampler \"halton\"");
+    assert_eq!(halton.image.sampler, SamplerKind::Sobol);
+    assert!(
+        halton.warnings.iter().any(|w| w.contains("test.pbrt:1:1: approximated: ") && w.contains("halton")),
+        "{:?}",
+        halton.warnings
+    );
 }
 
 #[test]
