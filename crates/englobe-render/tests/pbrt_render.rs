@@ -226,3 +226,31 @@ fn pbrt_materials_keep_energy_in_a_white_furnace() {
     let centre = render(&s).film.get(2, 2);
     assert!(centre.x > 1.5 * centre.z, "copper {centre}");
 }
+
+#[test]
+fn a_disk_light_gives_the_closed_form() {
+    // A disk of radius R emitting Le downwards at height h over a diffuse plane of reflectance
+    // rho: on its axis the irradiance is pi Le R^2 / (h^2 + R^2), the radiance rho Le R^2 /
+    // (h^2 + R^2). The camera sees the point under the disk's centre from the side through a
+    // tiny field of view, so all 64 pixels estimate that radiance independently; englobe draws
+    // pbrt's disk as 128 triangles, whose inscribed polygon has (128 / 2pi) sin(2pi / 128) =
+    // 0.9996 of the disk's area: a bias of 4e-4 at most, allowed for.
+    let (le, r, h, rho) = (3.0, 0.5, 1.0, 0.7);
+    let s = scene(&format!(
+        "LookAt 3 0 0.5  0 0 0  0 0 1\nCamera \"perspective\" \"float fov\" 0.01\n\
+         Film \"rgb\" \"integer xresolution\" 8 \"integer yresolution\" 8\n\
+         Sampler \"independent\" \"integer pixelsamples\" 256\nIntegrator \"path\" \"integer maxdepth\" 3\n\
+         WorldBegin\nAttributeBegin\nTranslate 0 0 {h}\nReverseOrientation\n\
+         AreaLightSource \"diffuse\" \"rgb L\" [{le} {le} {le}]\nMaterial \"diffuse\" \"rgb reflectance\" [0 0 0]\n\
+         Shape \"disk\" \"float radius\" {r}\nAttributeEnd\n\
+         Material \"diffuse\" \"rgb reflectance\" [{rho} {rho} {rho}]\n\
+         Shape \"trianglemesh\" \"point3 P\" [-50 -50 0 50 -50 0 50 50 0 -50 50 0] \"integer indices\" [0 1 2 0 2 3]\n"
+    ));
+    let values: Vec<f64> = render(&s).film.pixels().iter().map(|p| f64::from(p.x)).collect();
+    let n = values.len() as f64;
+    let mean = values.iter().sum::<f64>() / n;
+    let error = (values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0) / n).sqrt();
+    let expected = rho * le * r * r / (h * h + r * r);
+    assert!(error < 0.02 * expected, "the estimate is precise enough to test: {error}");
+    assert!((mean - expected).abs() < 4.0 * error + 4e-4 * expected, "{mean} ± {error} against {expected}");
+}
