@@ -254,3 +254,27 @@ fn a_disk_light_gives_the_closed_form() {
     assert!(error < 0.02 * expected, "the estimate is precise enough to test: {error}");
     assert!((mean - expected).abs() < 4.0 * error + 4e-4 * expected, "{mean} ± {error} against {expected}");
 }
+
+#[test]
+fn a_point_light_inside_a_closed_diffuse_sphere_gives_rho_over_one_minus_rho() {
+    // pbrt-v4's RadianceMatches: a point light of radiant intensity pi at the centre of a closed
+    // diffuse sphere of radius 1 and albedo rho gives every wall the irradiance pi, so the
+    // directly lit radiance rho; each further bounce multiplies it by rho (from a sphere's wall
+    // every other wall is seen with the same form factor): rho / (1 - rho) in all.
+    let rho = 0.6;
+    let s = scene(&format!(
+        "LookAt 0 0 0  0 0 1  0 1 0\nCamera \"perspective\" \"float fov\" 90\n\
+         Film \"rgb\" \"integer xresolution\" 8 \"integer yresolution\" 8\n\
+         Sampler \"independent\" \"integer pixelsamples\" 128\nIntegrator \"path\" \"integer maxdepth\" 100\n\
+         WorldBegin\nLightSource \"point\" \"rgb I\" [{pi} {pi} {pi}]\n\
+         Material \"diffuse\" \"rgb reflectance\" [{rho} {rho} {rho}]\nShape \"sphere\" \"float radius\" 1\n",
+        pi = PI
+    ));
+    let values: Vec<f64> = render(&s).film.pixels().iter().map(|p| f64::from(p.x)).collect();
+    let n = values.len() as f64;
+    let mean = values.iter().sum::<f64>() / n;
+    let error = (values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0) / n).sqrt();
+    let expected = rho / (1.0 - rho);
+    assert!(error < 0.02 * expected, "the estimate is precise enough to test: {error}");
+    assert!((mean - expected).abs() < 4.0 * error, "{mean} ± {error} against {expected}");
+}
