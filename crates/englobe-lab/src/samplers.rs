@@ -6,7 +6,8 @@
 //!
 //! The reference is rendered with independent samples and another seed, so that it is
 //! independent of both renders it judges; its own noise adds its variance (`1 / reference_spp`
-//! of one sample's) to every error, a floor the table prints.
+//! of one sample's) to every error, a floor the table prints: the independent errors are
+//! `v (1 / spp + 1 / reference_spp)` for one sample's variance `v`, which they estimate.
 
 use std::path::PathBuf;
 
@@ -137,7 +138,16 @@ impl SamplerExperiment {
         (log_log_slope(&points(|r| r.independent)), log_log_slope(&points(|r| r.sobol)))
     }
 
-    /// The table: one row per sample count, then the slopes.
+    /// The reference's own noise in every error: `v / reference_spp`, with one sample's variance
+    /// `v` estimated from the independent rows as the mean of `MSE / (1 / spp + 1 / reference_spp)`.
+    pub fn reference_floor(&self) -> f64 {
+        let r = f64::from(self.reference_spp);
+        let v = self.rows.iter().map(|row| row.independent / (1.0 / f64::from(row.spp) + 1.0 / r)).sum::<f64>()
+            / self.rows.len().max(1) as f64;
+        v / r
+    }
+
+    /// The table: one row per sample count, then the slopes and the reference's floor.
     pub fn table(&self) -> String {
         let mut s = format!(
             "{} at {}x{}, reference {} spp (independent, another seed); MSE of linear RGB (relative: / mean square {:.4e})\n",
@@ -155,6 +165,7 @@ impl SamplerExperiment {
         }
         let (i, o) = self.slopes();
         s += &format!("log-log slope of MSE against spp: independent {i:.3}, sobol {o:.3}\n");
+        s += &format!("the reference's own noise in every MSE: about {:.2e}\n", self.reference_floor());
         s
     }
 }
@@ -162,6 +173,21 @@ impl SamplerExperiment {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_floor_is_the_reference_share_of_independent_errors() {
+        // v = 0.5, reference 1000 spp: independent errors 0.5 (1/n + 1/1000), floor 5e-4.
+        let rows = [10u32, 100].map(|spp| SamplerRow { spp, independent: 0.5 * (1.0 / spp as f64 + 1e-3), sobol: 0.0 });
+        let e = SamplerExperiment {
+            scene: String::new(),
+            width: 1,
+            height: 1,
+            reference_spp: 1000,
+            mean_square: 1.0,
+            rows: rows.to_vec(),
+        };
+        assert!((e.reference_floor() - 5e-4).abs() < 1e-12);
+    }
 
     #[test]
     fn the_slope_of_a_power_law_is_its_exponent() {
