@@ -14,10 +14,10 @@ use std::time::Instant;
 
 use englobe::{Counters, NoCount, Vec3, WorkCounts, World};
 use englobe_scene::{ImageSettings, IntegratorKind, Scene};
-use rand::{RngExt, SeedableRng};
-use rand_pcg::Pcg32;
+use rand::RngExt;
 
 use crate::sampler::PixelSampler;
+pub use crate::sampler::pixel_rng;
 use rayon::prelude::*;
 
 use crate::camera::ImageCamera;
@@ -412,10 +412,4 @@ impl Renderer<'_> {
     pub(crate) fn pixel_sampler(&self, x: u32, y: u32) -> PixelSampler {
         PixelSampler::new(self.scene.image.sampler, self.scene.image.seed, x, y)
     }
-}
-
-/// The independent sample generator of one pixel: depends on the seed and the pixel only, never
-/// on threads.
-pub fn pixel_rng(seed: u64, x: u32, y: u32) -> Pcg32 {
-    Pcg32::seed_from_u64(seed ^ ((y as u64) << 32 | x as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15))
 }

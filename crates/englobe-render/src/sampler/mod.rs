@@ -19,10 +19,14 @@ pub mod sobol;
 use std::convert::Infallible;
 
 use englobe_scene::SamplerKind;
-use rand::{Rng, TryRng};
+use rand::{Rng, SeedableRng, TryRng};
 use rand_pcg::Pcg32;
 
-use crate::render::pixel_rng;
+/// The independent sample generator of one pixel: depends on the seed and the pixel only, never
+/// on threads.
+pub fn pixel_rng(seed: u64, x: u32, y: u32) -> Pcg32 {
+    Pcg32::seed_from_u64(seed ^ ((y as u64) << 32 | x as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15))
+}
 
 /// The random numbers of one pixel.
 #[derive(Clone, Debug)]
