@@ -1,6 +1,7 @@
 //! `englobe experiment seed`: the seed report's four tests with every accelerator, beside the
 //! report's figures (see `englobe_lab::seed_experiment`); `englobe experiment fewer-rays`: the
-//! report's other family of speed-ups, measured (see `englobe_lab::fewer_rays`). This file parses
+//! report's other family of speed-ups, measured (see `englobe_lab::fewer_rays`); `englobe
+//! experiment samplers`: the pixel samplers' errors (see `englobe_lab::samplers`). This file parses
 //! the arguments and prints what the experiments return.
 
 use std::path::PathBuf;
@@ -10,7 +11,7 @@ use anyhow::Context;
 use clap::{Args, ValueEnum};
 use englobe::AccelKind;
 use englobe_lab::html_report::{render_seed_pictures, write_seed_report};
-use englobe_lab::{FewerRaysOptions, SeedOptions, run_fewer_rays, run_seed};
+use englobe_lab::{FewerRaysOptions, SamplerOptions, SeedOptions, run_fewer_rays, run_samplers, run_seed};
 
 use crate::image_options::parse_accel;
 
@@ -25,6 +26,10 @@ pub enum Experiment {
     /// (or the SCENEs given): rays per kind, exact tests, time, the image's difference (RMSE,
     /// SSIM), and the samples uniform sampling needs for adaptive sampling's error.
     FewerRays,
+    /// The pixel samplers: the mean squared error of independent and Owen-scrambled Sobol
+    /// samples at 4, 16, 64 and 256 spp against a 4096-spp reference, on the path-traced Cornell
+    /// box (or the SCENE given), with each error's log-log slope against the samples.
+    Samplers,
 }
 
 #[derive(Args)]
@@ -83,6 +88,9 @@ pub fn run(args: ExperimentArgs) -> anyhow::Result<ExitCode> {
     if args.experiment == Experiment::FewerRays {
         return fewer_rays(args);
     }
+    if args.experiment == Experiment::Samplers {
+        return samplers(args);
+    }
     if let Some(dir) = &args.report {
         // Checked before the experiment runs, so that it never ends in "cannot write".
         std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
@@ -124,6 +132,40 @@ pub fn run(args: ExperimentArgs) -> anyhow::Result<ExitCode> {
     if !experiment.images_identical() {
         eprintln!("error: some accelerators drew a different image than brute force (see the image column)");
         return Ok(ExitCode::from(2));
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn samplers(args: ExperimentArgs) -> anyhow::Result<ExitCode> {
+    anyhow::ensure!(
+        args.scenes.len() <= 1
+            && args.report.is_none()
+            && args.thresholds.is_empty()
+            && args.noise_thresholds.is_empty()
+            && args.tests.is_empty()
+            && args.accel.is_empty()
+            && args.images.is_none(),
+        "samplers takes one SCENE, --path-size, --reference-spp, --threads and --json"
+    );
+    let mut options = SamplerOptions { threads: args.threads, ..SamplerOptions::default() };
+    if let Some(scene) = args.scenes.first() {
+        options.scene = scene.clone();
+    }
+    if let Some(size) = args.path_size {
+        options.size = size;
+    }
+    if let Some(spp) = args.reference_spp {
+        options.reference_spp = spp;
+    }
+    let quiet = args.quiet;
+    let experiment = run_samplers(&options, &mut |line| {
+        if !quiet {
+            eprintln!("{line}");
+        }
+    })?;
+    print!("{}", experiment.table());
+    if let Some(path) = &args.json {
+        englobe_lab::report::write_json(path, &experiment)?;
     }
     Ok(ExitCode::SUCCESS)
 }

@@ -1,6 +1,7 @@
 //! `englobe info FILE`: what a mesh file or a scene file holds (triangles, vertices, bounds,
 //! materials with their model, factors and texture slots, textures with their sizes and which
-//! could not be read, instances, warnings), or the error that refuses it.
+//! could not be read, instances, warnings), or the error that refuses it; for an OpenEXR image,
+//! its mean colour (see [`crate::image_stats`]).
 
 use std::collections::HashSet;
 use std::fmt::Write as _;
@@ -14,8 +15,12 @@ use englobe_scene::{Material, MaterialModel, Scene, Texture, load_scene};
 
 #[derive(Args)]
 pub struct InfoArgs {
-    /// A mesh file (.obj, .ply, .gltf, .glb) or a scene file (.toml, or pbrt-v4 .pbrt).
+    /// A mesh file (.obj, .ply, .gltf, .glb), a scene file (.toml, or pbrt-v4 .pbrt), or an
+    /// OpenEXR image (.exr: its size and mean linear RGB).
     file: PathBuf,
+    /// For an OpenEXR image: also the mean RGB of the pixels X0..X1, Y0..Y1 (row 0 at the top).
+    #[arg(long, value_name = "X0,Y0,X1,Y1", value_parser = crate::image_stats::parse_patch)]
+    patch: Option<crate::image_stats::Patch>,
     /// For a pbrt scene: refuse it, at the first thing englobe would skip or approximate, instead
     /// of listing those as warnings.
     #[arg(long)]
@@ -24,7 +29,11 @@ pub struct InfoArgs {
 
 pub fn run(args: InfoArgs) -> anyhow::Result<ExitCode> {
     let is_scene = args.file.extension().is_some_and(|e| e.eq_ignore_ascii_case("toml"));
-    let text = if englobe_scene::pbrt::is_pbrt_path(&args.file) {
+    let is_image = args.file.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr"));
+    anyhow::ensure!(is_image || args.patch.is_none(), "--patch is for OpenEXR images");
+    let text = if is_image {
+        crate::image_stats::image_info(&args.file, args.patch)?
+    } else if englobe_scene::pbrt::is_pbrt_path(&args.file) {
         scene_info(&args.file, &englobe_scene::pbrt::load(&args.file, args.strict)?)
     } else if is_scene {
         scene_info(&args.file, &load_scene(&args.file)?)
@@ -97,6 +106,11 @@ fn material_text(m: &Material, textures: &[std::sync::Arc<Texture>]) -> String {
             "metallic_roughness, base colour {}, metallic {metallic}, roughness {roughness}, transmission {transmission}, ior {}",
             m.diffuse, m.ior
         ),
+        MaterialModel::Conductor { eta, k, alpha } => format!("conductor, eta {eta}, k {k}, alpha {alpha}"),
+        MaterialModel::Dielectric { alpha } => format!("dielectric, ior {}, alpha {alpha}", m.ior),
+        MaterialModel::CoatedDiffuse { alpha } => {
+            format!("coated_diffuse, reflectance {}, coat ior {}, alpha {alpha}", m.diffuse, m.ior)
+        }
     };
     if m.emission != englobe::Vec3::ZERO {
         let _ = write!(s, ", emission {}", m.emission);

@@ -9,6 +9,7 @@ mod compare_cmd;
 mod experiment_cmd;
 mod farm_cmd;
 mod image_options;
+mod image_stats;
 mod info_cmd;
 mod interrupt;
 mod progress;

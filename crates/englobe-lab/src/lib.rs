@@ -4,7 +4,7 @@
 //! scenes and figures of [`seed_report`]), its other family of speed-ups, fewer rays
 //! ([`fewer_rays`], [`fewer_samples`] for the path tracer's adaptive sampling and [`ray_cones`]
 //! for texture filtering by ray cones, with
-//! [`image_error`] saying what an image loses) and the comparison of every acceleration structure on one
+//! [`image_error`] saying what an image loses), the pixel samplers' errors ([`samplers`]) and the comparison of every acceleration structure on one
 //! scene ([`compare`]), both built on [`measure`] (build, render, time, compare images); their
 //! reports ([`report`]: tables and JSON; [`html_report`]: the comparison and the seed experiment, each
 //! as one self-contained page) and plot ([`plot`]: SVG). The `englobe` command parses its
@@ -34,10 +34,12 @@ pub mod memory;
 pub mod plot;
 pub mod ray_cones;
 pub mod report;
+pub mod samplers;
 pub mod seed_experiment;
 pub mod seed_report;
 
 pub use compare::{CompareOptions, CompareRow, Comparison, run_compare};
 pub use error::LabError;
 pub use fewer_rays::{FewerRays, FewerRaysOptions, run_fewer_rays};
+pub use samplers::{SamplerExperiment, SamplerOptions, run_samplers};
 pub use seed_experiment::{SeedExperiment, SeedOptions, SeedRow, run_seed};

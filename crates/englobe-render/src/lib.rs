@@ -33,6 +33,7 @@ mod passes;
 pub mod path;
 pub mod ray_cone;
 pub mod render;
+pub mod sampler;
 pub mod sampling;
 pub mod shading;
 pub mod sphere_lights;

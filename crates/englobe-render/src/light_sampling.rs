@@ -17,8 +17,7 @@
 
 use englobe::{Counters, Ray, Vec2, Vec3};
 use englobe_scene::Scene;
-use rand::RngExt;
-use rand_pcg::Pcg32;
+use rand::{Rng, RngExt};
 
 use crate::emitters::power_heuristic;
 use crate::environment::EnvironmentLight;
@@ -60,7 +59,7 @@ impl SampledLights {
         &self,
         s: &Surface,
         vis: &Visibility,
-        rng: &mut Pcg32,
+        rng: &mut impl Rng,
         tally: &mut Tally<C>,
         bsdf: impl Fn(Vec3) -> (Vec3, f32),
     ) -> Vec3 {

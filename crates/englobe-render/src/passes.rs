@@ -13,11 +13,11 @@ use std::time::Instant;
 
 use englobe::{Counters, NoCount, Vec3, WorkCounts};
 use englobe_scene::ImageSettings;
-use rand_pcg::Pcg32;
 use rayon::prelude::*;
 
 use crate::film::Film;
-use crate::render::{RenderError, RenderOutput, Renderer, TILE_SIZE, pixel_rng};
+use crate::render::{RenderError, RenderOutput, Renderer, TILE_SIZE};
+use crate::sampler::PixelSampler;
 use crate::stats::{RenderStats, Tally};
 use crate::tile::PixelWindow;
 
@@ -54,9 +54,8 @@ impl Renderer<'_> {
         let (camera, integrator) = self.parts();
         let window = self.window.unwrap_or(PixelWindow::full(self.width, self.height));
         let (w, h) = (window.width() as usize, window.height() as usize);
-        let seed = self.scene.image.seed;
         let at = |i: usize| (window.x0 + (i % w) as u32, window.y0 + (i / w) as u32);
-        let mut rngs: Vec<Pcg32> = (0..w * h).map(at).map(|(x, y)| pixel_rng(seed, x, y)).collect();
+        let mut rngs: Vec<PixelSampler> = (0..w * h).map(at).map(|(x, y)| self.pixel_sampler(x, y)).collect();
         let mut sums = vec![Vec3::ZERO; w * h];
         let mut values = vec![Vec3::ZERO; w * h];
         let stop =

@@ -21,10 +21,9 @@ use std::f32::consts::PI;
 
 use englobe::{Counters, Object, Ray, Shape, Vec2, Vec3, World, WorldHit};
 use englobe_scene::{MaterialModel, Scene};
-use rand::RngExt;
-use rand_pcg::Pcg32;
+use rand::{Rng, RngExt};
 
-use crate::bsdf::{Bsdf, Frame, SampleKind};
+use crate::bsdf::{Bsdf, Frame, SampleKind, TrowbridgeReitz};
 use crate::emitters::{Emitters, power_heuristic};
 use crate::light_sampling::SampledLights;
 use crate::optics::{fresnel_dielectric, reflect, refract};
@@ -92,7 +91,7 @@ impl<'a> PathTracer<'a> {
     fn sample_emitters<C: Counters>(
         &self,
         s: &Surface,
-        rng: &mut Pcg32,
+        rng: &mut impl Rng,
         tally: &mut Tally<C>,
         bsdf: impl Fn(Vec3) -> (Vec3, f32),
     ) -> Vec3 {
@@ -120,19 +119,18 @@ impl<'a> PathTracer<'a> {
         f_cos * e.emission * (power_heuristic(pdf_light, pdf_bounce) / pdf_light)
     }
 
-    /// A microfacet surface (glTF's metallic-roughness model, see [`crate::bsdf`]): light from
+    /// A surface with a BSDF ([`surface_bsdf`], see [`crate::bsdf`]): light from
     /// the point and directional lights and from the emitters, added to `radiance`, and where the
     /// path goes on, drawn from the BSDF.
     fn scatter_microfacet<C: Counters>(
         &self,
         s: &Surface,
-        rng: &mut Pcg32,
+        rng: &mut impl Rng,
         tally: &mut Tally<C>,
         throughput: Vec3,
         radiance: &mut Vec3,
     ) -> Option<Scatter> {
-        let p = &s.params;
-        let bsdf = Bsdf::metallic_roughness(p.base_color, p.metallic, p.roughness, p.transmission, p.ior);
+        let bsdf = surface_bsdf(s);
         // The frame of a transmitting BSDF must face outward; the others are two-sided.
         let frame = Frame::from_z(if s.entering { s.ns } else { -s.ns });
         let wo = frame.to_local(-s.d);
@@ -174,7 +172,7 @@ impl<'a> PathTracer<'a> {
     fn scatter_classic<C: Counters>(
         &self,
         s: &Surface,
-        rng: &mut Pcg32,
+        rng: &mut impl Rng,
         tally: &mut Tally<C>,
         throughput: Vec3,
         radiance: &mut Vec3,
@@ -228,7 +226,7 @@ impl<'a> PathTracer<'a> {
     }
 
     /// One estimate of the radiance along the primary ray `ray`.
-    pub fn radiance<C: Counters>(&self, ray: &Ray, rng: &mut Pcg32, tally: &mut Tally<C>) -> Vec3 {
+    pub fn radiance<C: Counters>(&self, ray: &Ray, rng: &mut impl Rng, tally: &mut Tally<C>) -> Vec3 {
         let mut radiance = Vec3::ZERO;
         let mut throughput = Vec3::ONE;
         let mut ray = *ray;
@@ -262,9 +260,7 @@ impl<'a> PathTracer<'a> {
             }
             let next = match s.material.model {
                 MaterialModel::Classic => self.scatter_classic(&s, rng, tally, throughput, &mut radiance),
-                MaterialModel::MetallicRoughness { .. } => {
-                    self.scatter_microfacet(&s, rng, tally, throughput, &mut radiance)
-                }
+                _ => self.scatter_microfacet(&s, rng, tally, throughput, &mut radiance),
             };
             let Some(next) = next else { break };
             throughput *= next.weight;
@@ -278,5 +274,17 @@ impl<'a> PathTracer<'a> {
             }
         }
         radiance
+    }
+}
+
+/// The BSDF of a surface whose material is not classic: glTF's metallic-roughness model, or
+/// pbrt-v4's conductor, dielectric and coated diffuse (see `englobe_scene::MaterialModel`).
+fn surface_bsdf(s: &Surface) -> Bsdf {
+    let p = &s.params;
+    match s.material.model {
+        MaterialModel::Conductor { eta, k, alpha } => Bsdf::conductor(eta, k, TrowbridgeReitz::isotropic(alpha)),
+        MaterialModel::Dielectric { alpha } => Bsdf::dielectric(p.ior, TrowbridgeReitz::isotropic(alpha)),
+        MaterialModel::CoatedDiffuse { alpha } => Bsdf::plastic(p.base_color, alpha, p.ior),
+        _ => Bsdf::metallic_roughness(p.base_color, p.metallic, p.roughness, p.transmission, p.ior),
     }
 }

@@ -14,8 +14,10 @@ use std::time::Instant;
 
 use englobe::{Counters, NoCount, Vec3, WorkCounts, World};
 use englobe_scene::{ImageSettings, IntegratorKind, Scene, TextureFilter};
-use rand::{RngExt, SeedableRng};
-use rand_pcg::Pcg32;
+use rand::RngExt;
+
+use crate::sampler::PixelSampler;
+pub use crate::sampler::pixel_rng;
 use rayon::prelude::*;
 
 use crate::camera::ImageCamera;
@@ -297,9 +299,12 @@ impl<'a> Renderer<'a> {
         y: u32,
         tally: &mut Tally<C>,
     ) -> Vec3 {
-        let mut rng = pixel_rng(self.scene.image.seed, x, y);
+        let mut rng = self.pixel_sampler(x, y);
         if let Some(adaptive) = self.supersampling {
-            let mut at = |dx: f32, dy: f32| self.sample_at(camera, integrator, x, y, dx, dy, &mut rng, tally);
+            let mut at = |dx: f32, dy: f32| {
+                rng.start_sample();
+                self.sample_at(camera, integrator, x, y, dx, dy, &mut rng, tally)
+            };
             return adaptive.pixel(&mut at).0;
         }
         if self.samples == 1 {
@@ -324,9 +329,10 @@ impl<'a> Renderer<'a> {
         integrator: &Integrator,
         x: u32,
         y: u32,
-        rng: &mut Pcg32,
+        rng: &mut PixelSampler,
         tally: &mut Tally<C>,
     ) -> Vec3 {
+        rng.start_sample();
         let (dx, dy): (f32, f32) =
             if self.samples == 1 { (0.5, 0.5) } else { self.filter.sample(rng.random(), rng.random()) };
         self.sample_at(camera, integrator, x, y, dx, dy, rng, tally)
@@ -344,7 +350,7 @@ impl<'a> Renderer<'a> {
         y: u32,
         dx: f32,
         dy: f32,
-        rng: &mut Pcg32,
+        rng: &mut PixelSampler,
         tally: &mut Tally<C>,
     ) -> Vec3 {
         let ray = if camera.has_lens() {
@@ -405,7 +411,9 @@ pub fn clamp_sample(radiance: Vec3, most: f32) -> Vec3 {
     }
 }
 
-/// The sample generator of one pixel: depends on the seed and the pixel only, never on threads.
-pub fn pixel_rng(seed: u64, x: u32, y: u32) -> Pcg32 {
-    Pcg32::seed_from_u64(seed ^ ((y as u64) << 32 | x as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15))
+impl Renderer<'_> {
+    /// The random numbers of pixel `(x, y)` (see [`crate::sampler`]).
+    pub(crate) fn pixel_sampler(&self, x: u32, y: u32) -> PixelSampler {
+        PixelSampler::new(self.scene.image.sampler, self.scene.image.seed, x, y)
+    }
 }

@@ -168,3 +168,113 @@ fn the_cornell_box_has_its_red_wall_left_and_its_lamp_on_the_ceiling() {
     let floor = mean(8..16, 58..63);
     assert!(floor.x > 0.1 && floor.x < 0.3, "floor {floor}");
 }
+
+/// The mean of the pixels of a unit sphere of pbrt material `material` seen under a white sky
+/// (pbrt's `infinite` light of radiance 1), and the standard error of that mean (pixels are
+/// independent estimates). The sphere fills the image, even where pbrt's default filter (a
+/// Gaussian of radius 1.5 pixels) reaches beyond its edge.
+fn pbrt_furnace(material: &str) -> (f64, f64) {
+    let s = scene(&format!(
+        "LookAt 0 0 4  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" 16\n\
+         Film \"rgb\" \"integer xresolution\" 16 \"integer yresolution\" 16\n\
+         Sampler \"independent\" \"integer pixelsamples\" 64\nIntegrator \"path\" \"integer maxdepth\" 64\n\
+         WorldBegin\nLightSource \"infinite\" \"rgb L\" [1 1 1]\nMaterial {material}\nShape \"sphere\"\n"
+    ));
+    let values: Vec<f64> = render(&s).film.pixels().iter().map(|p| f64::from(p.element_sum()) / 3.0).collect();
+    let n = values.len() as f64;
+    let mean = values.iter().sum::<f64>() / n;
+    let variance = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0);
+    (mean, (variance / n).sqrt())
+}
+
+#[test]
+fn pbrt_materials_keep_energy_in_a_white_furnace() {
+    // (material, expected, bias allowed): a white Lambertian, a smooth glass (which reflects or
+    // transmits everything) and a white coated diffuse (the plastic BSDF, white to 0.003: its
+    // albedo table's interpolation) vanish; pbrt's reflectance 1 becomes 0.999 (k finite); a
+    // grey diffuse convex object is seen as its albedo, 0.5.
+    for (material, expected, bias) in [
+        ("\"diffuse\" \"rgb reflectance\" [1 1 1]", 1.0, 0.0),
+        ("\"diffuse\" \"rgb reflectance\" [0.5 0.5 0.5]", 0.5, 0.0),
+        ("\"dielectric\" \"float eta\" 1.5", 1.0, 0.0),
+        ("\"conductor\" \"rgb reflectance\" [1 1 1]", 1.0, 0.0015),
+        ("\"coateddiffuse\" \"rgb reflectance\" [1 1 1] \"float roughness\" 0.1", 1.0, 0.003),
+        ("\"coateddiffuse\" \"rgb reflectance\" [1 1 1]", 1.0, 0.003),
+    ] {
+        let (mean, error) = pbrt_furnace(material);
+        assert!(
+            (mean - expected).abs() < 4.0 * error + bias + 1e-6,
+            "{material}: {mean} ± {error}, expected {expected}"
+        );
+    }
+    // Rough microfacet surfaces lose the light that would scatter between microfacets more than
+    // once (single-scattering models): clearly below 1. At alpha 0.5 a white GGX conductor
+    // reflects 0.688 of the light at normal incidence (quadrature of D G2 / (4 cos), height-
+    // correlated Smith), more towards grazing angles, so the sphere's mean lies above 0.6.
+    for material in [
+        "\"conductor\" \"rgb reflectance\" [1 1 1] \"float roughness\" 0.25",
+        "\"dielectric\" \"float eta\" 1.5 \"float roughness\" 0.09",
+    ] {
+        let (mean, error) = pbrt_furnace(material);
+        assert!(mean < 1.0 - 4.0 * error && mean > 0.6, "{material}: {mean} ± {error}");
+    }
+    // A copper conductor is coloured: red above blue.
+    let s = scene(
+        "LookAt 0 0 4  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" 20\nFilm \"rgb\" \"integer xresolution\" 4 \
+         \"integer yresolution\" 4\nWorldBegin\nLightSource \"infinite\" \"rgb L\" [1 1 1]\nMaterial \"conductor\"\nShape \"sphere\"\n",
+    );
+    let centre = render(&s).film.get(2, 2);
+    assert!(centre.x > 1.5 * centre.z, "copper {centre}");
+}
+
+#[test]
+fn a_disk_light_gives_the_closed_form() {
+    // A disk of radius R emitting Le downwards at height h over a diffuse plane of reflectance
+    // rho: on its axis the irradiance is pi Le R^2 / (h^2 + R^2), the radiance rho Le R^2 /
+    // (h^2 + R^2). The camera sees the point under the disk's centre from the side through a
+    // tiny field of view, so all 64 pixels estimate that radiance independently; englobe draws
+    // pbrt's disk as 128 triangles, whose inscribed polygon has (128 / 2pi) sin(2pi / 128) =
+    // 0.9996 of the disk's area: a bias of 4e-4 at most, allowed for.
+    let (le, r, h, rho) = (3.0, 0.5, 1.0, 0.7);
+    let s = scene(&format!(
+        "LookAt 3 0 0.5  0 0 0  0 0 1\nCamera \"perspective\" \"float fov\" 0.01\n\
+         Film \"rgb\" \"integer xresolution\" 8 \"integer yresolution\" 8\n\
+         Sampler \"independent\" \"integer pixelsamples\" 256\nIntegrator \"path\" \"integer maxdepth\" 3\n\
+         WorldBegin\nAttributeBegin\nTranslate 0 0 {h}\nReverseOrientation\n\
+         AreaLightSource \"diffuse\" \"rgb L\" [{le} {le} {le}]\nMaterial \"diffuse\" \"rgb reflectance\" [0 0 0]\n\
+         Shape \"disk\" \"float radius\" {r}\nAttributeEnd\n\
+         Material \"diffuse\" \"rgb reflectance\" [{rho} {rho} {rho}]\n\
+         Shape \"trianglemesh\" \"point3 P\" [-50 -50 0 50 -50 0 50 50 0 -50 50 0] \"integer indices\" [0 1 2 0 2 3]\n"
+    ));
+    let values: Vec<f64> = render(&s).film.pixels().iter().map(|p| f64::from(p.x)).collect();
+    let n = values.len() as f64;
+    let mean = values.iter().sum::<f64>() / n;
+    let error = (values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0) / n).sqrt();
+    let expected = rho * le * r * r / (h * h + r * r);
+    assert!(error < 0.02 * expected, "the estimate is precise enough to test: {error}");
+    assert!((mean - expected).abs() < 4.0 * error + 4e-4 * expected, "{mean} ± {error} against {expected}");
+}
+
+#[test]
+fn a_point_light_inside_a_closed_diffuse_sphere_gives_rho_over_one_minus_rho() {
+    // pbrt-v4's RadianceMatches: a point light of radiant intensity pi at the centre of a closed
+    // diffuse sphere of radius 1 and albedo rho gives every wall the irradiance pi, so the
+    // directly lit radiance rho; each further bounce multiplies it by rho (from a sphere's wall
+    // every other wall is seen with the same form factor): rho / (1 - rho) in all.
+    let rho = 0.6;
+    let s = scene(&format!(
+        "LookAt 0 0 0  0 0 1  0 1 0\nCamera \"perspective\" \"float fov\" 90\n\
+         Film \"rgb\" \"integer xresolution\" 8 \"integer yresolution\" 8\n\
+         Sampler \"independent\" \"integer pixelsamples\" 128\nIntegrator \"path\" \"integer maxdepth\" 100\n\
+         WorldBegin\nLightSource \"point\" \"rgb I\" [{pi} {pi} {pi}]\n\
+         Material \"diffuse\" \"rgb reflectance\" [{rho} {rho} {rho}]\nShape \"sphere\" \"float radius\" 1\n",
+        pi = PI
+    ));
+    let values: Vec<f64> = render(&s).film.pixels().iter().map(|p| f64::from(p.x)).collect();
+    let n = values.len() as f64;
+    let mean = values.iter().sum::<f64>() / n;
+    let error = (values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0) / n).sqrt();
+    let expected = rho / (1.0 - rho);
+    assert!(error < 0.02 * expected, "the estimate is precise enough to test: {error}");
+    assert!((mean - expected).abs() < 4.0 * error, "{mean} ± {error} against {expected}");
+}

@@ -64,6 +64,8 @@ pub struct ImageDef {
     #[serde(default)]
     pub seed: u64,
     #[serde(default)]
+    pub sampler: crate::model::SamplerKind,
+    #[serde(default)]
     pub integrator: crate::model::IntegratorKind,
     pub exposure: Option<Spanned<Finite>>,
     #[serde(default)]

@@ -34,7 +34,7 @@ pub use material::{
 pub use material_eval::{MISSING_TEXTURE_COLOR, SurfaceParams};
 pub use model::{
     Camera, ImageSettings, IntegratorKind, Light, MAX_DEPTH, MAX_PIXELS, MAX_SAMPLES, Material, MaterialId,
-    OutputSettings, Projection, Scene, SceneObject, TextureFilter, ToneMap,
+    OutputSettings, Projection, SamplerKind, Scene, SceneObject, TextureFilter, ToneMap,
 };
 pub use overrides::Override;
 pub use parse::{DEFAULT_MATERIAL, load_scene, load_scene_with, parse_scene, parse_scene_with};

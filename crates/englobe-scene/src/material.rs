@@ -33,6 +33,31 @@ pub enum MaterialModel {
         /// (thin-walled or refracting by `ior`, as the renderer decides), in `0..=1`.
         transmission: f32,
     },
+    /// A conductor of complex index `eta + i k` per RGB channel (pbrt-v4's `conductor`): a
+    /// mirror when `alpha` is below 0.001, otherwise Trowbridge-Reitz (GGX) microfacet reflection
+    /// of that `alpha`, both with the exact conductor Fresnel equations. The classic fields hold a
+    /// stand-in for the Whitted integrator (a mirror or a diffuse colour).
+    Conductor {
+        /// Real part of the index, per channel.
+        eta: Vec3,
+        /// Imaginary part (absorption), per channel.
+        k: Vec3,
+        /// Microfacet roughness `alpha`.
+        alpha: f32,
+    },
+    /// A dielectric of index `Material::ior` (pbrt-v4's `dielectric`): smooth glass when `alpha`
+    /// is below 0.001, otherwise Walter et al.'s rough dielectric of that `alpha`.
+    Dielectric {
+        /// Microfacet roughness `alpha`.
+        alpha: f32,
+    },
+    /// A diffuse base of colour `Material::diffuse` under a dielectric coat of index
+    /// `Material::ior` and microfacet roughness `alpha` (pbrt-v4's `coateddiffuse`, rendered as
+    /// the renderer's plastic BSDF: see docs/pbrt.md for what this approximates).
+    CoatedDiffuse {
+        /// Microfacet roughness `alpha` of the coat.
+        alpha: f32,
+    },
 }
 
 impl MaterialModel {
@@ -41,6 +66,9 @@ impl MaterialModel {
         match self {
             MaterialModel::Classic => "classic",
             MaterialModel::MetallicRoughness { .. } => "metallic_roughness",
+            MaterialModel::Conductor { .. } => "conductor",
+            MaterialModel::Dielectric { .. } => "dielectric",
+            MaterialModel::CoatedDiffuse { .. } => "coated_diffuse",
         }
     }
 }

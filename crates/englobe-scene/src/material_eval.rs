@@ -145,6 +145,13 @@ impl Material {
                     _ => (metallic, roughness, transmission, Vec3::ONE),
                 }
             }
+            // The path tracer reads these models' own parameters; the numbers here are what the
+            // classic fields say, for the integrators that only know those.
+            MaterialModel::Conductor { .. }
+            | MaterialModel::Dielectric { .. }
+            | MaterialModel::CoatedDiffuse { .. } => {
+                (0.0, shininess_to_roughness(self.shininess), self.transparency, self.specular)
+            }
         };
         let normal_ts = match (t.normal, uv) {
             (Some(n), Some(uv)) => self.normal_from_map(textures, &n, uv, footprint),

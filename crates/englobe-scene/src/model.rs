@@ -49,6 +49,8 @@ pub struct ImageSettings {
     pub ambient: Vec3,
     /// Seed of the pixel sampler; the same seed gives the same image.
     pub seed: u64,
+    /// Where the pixel sampler's numbers come from.
+    pub sampler: SamplerKind,
     /// How light is computed.
     pub integrator: IntegratorKind,
     /// Which samples a pixel averages (with more than one sample per pixel): the box of radius
@@ -122,6 +124,27 @@ impl ToneMap {
         match self {
             ToneMap::None => "none",
             ToneMap::Filmic => "filmic",
+        }
+    }
+}
+
+/// Where a pixel's random numbers come from (see englobe-render's `sampler`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Deserialize, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum SamplerKind {
+    /// Independent uniform numbers (a PCG32 stream per pixel).
+    #[default]
+    Independent,
+    /// Owen-scrambled Sobol points padded in groups of four dimensions (Burley 2020).
+    Sobol,
+}
+
+impl SamplerKind {
+    /// The name used in scene files.
+    pub fn name(self) -> &'static str {
+        match self {
+            SamplerKind::Independent => "independent",
+            SamplerKind::Sobol => "sobol",
         }
     }
 }

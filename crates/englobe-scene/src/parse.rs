@@ -260,6 +260,7 @@ impl Converter<'_> {
             background: i.background.map_or(Vec3::ZERO, |c| c.0),
             ambient: i.ambient.map_or(Vec3::ZERO, |c| c.0),
             seed: i.seed,
+            sampler: i.sampler,
             integrator: i.integrator,
             clamp: i.clamp.map(|c| c.0),
             output: crate::model::OutputSettings { exposure, tonemap: i.tonemap, exr_half: i.exr_half },

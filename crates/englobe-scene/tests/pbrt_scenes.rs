@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use englobe::{Object, Vec2, Vec3};
 use englobe_scene::pbrt::{is_pbrt_path, load, parse};
 use englobe_scene::shared_data::locate_shared;
-use englobe_scene::{Light, PixelFilter, Scene, SceneError};
+use englobe_scene::{Light, MaterialModel, PixelFilter, SamplerKind, Scene, SceneError};
 
 fn shared_scenes() -> PathBuf {
     let here = Path::new(env!("CARGO_MANIFEST_DIR"));
@@ -79,8 +79,10 @@ fn the_cornell_box_reads_as_its_readme_says() {
     let red = s.objects.iter().find(|o| s.material_names[o.material as usize] == "LeftWall").unwrap();
     let Object::Mesh(wall) = &red.object else { panic!() };
     assert!(wall.positions().iter().all(|p| (p.x + 1.0).abs() < 1e-6));
-    // Only what does not change the picture is reported: the film's file name and the sampler.
-    assert_eq!(s.warnings.len(), 2, "{:?}", s.warnings);
+    // Only what does not change the picture is reported: the film's file name (its "sobol"
+    // sampler is englobe's Sobol sampler).
+    assert_eq!(s.image.sampler, englobe_scene::SamplerKind::Sobol);
+    assert_eq!(s.warnings.len(), 1, "{:?}", s.warnings);
     assert!(s.warnings.iter().all(|w| w.contains(": ignored: ")), "{:?}", s.warnings);
     assert!(s.warnings[0].contains("scene-v4.pbrt:10:5") && s.warnings[0].contains("cornell-box.png"));
 }
@@ -214,30 +216,73 @@ fn lights_are_converted_to_englobes_units() {
 }
 
 #[test]
-fn materials_map_to_the_nearest_classic_one_and_say_so() {
+fn materials_map_to_their_bsdfs_and_say_what_is_approximated() {
     let s = scene(
         "WorldBegin\nMakeNamedMaterial \"glass\" \"string type\" \"dielectric\" \"float eta\" 1.33\n\
          MakeNamedMaterial \"chrome\" \"string type\" \"conductor\" \"rgb reflectance\" [0.9 0.9 0.9]\n\
          MakeNamedMaterial \"frosted\" \"string type\" \"dielectric\" \"float roughness\" 0.3\n\
          MakeNamedMaterial \"coat\" \"string type\" \"coateddiffuse\" \"rgb reflectance\" [0.5 0.2 0.1]\n\
+         MakeNamedMaterial \"gold\" \"string type\" \"conductor\" \"spectrum eta\" \"metal-Au-eta\"\n\
+           \"spectrum k\" \"metal-Au-k\" \"float roughness\" 0.01\n\
+         MakeNamedMaterial \"brushed\" \"string type\" \"conductor\" \"rgb eta\" [0.2 0.9 1.1] \"rgb k\" [3.9 2.4 2.1]\n\
+           \"float uroughness\" 0.04 \"float vroughness\" 0.16\n\
+         MakeNamedMaterial \"raw\" \"string type\" \"dielectric\" \"float roughness\" 0.2 \"bool remaproughness\" false\n\
          NamedMaterial \"later\"\nShape \"sphere\"\nMakeNamedMaterial \"later\" \"string type\" \"diffuse\"\n",
     );
     let m = |name: &str| s.materials[s.material_names.iter().position(|n| n == name).unwrap()].clone();
-    assert_eq!((m("glass").transparency, m("glass").ior, m("glass").diffuse), (1.0, 1.33, Vec3::ZERO));
-    assert!((m("chrome").reflectivity - 0.9).abs() < 1e-6 && m("chrome").diffuse == Vec3::ZERO);
-    assert_eq!((m("frosted").transparency, m("frosted").ior), (1.0, 1.5));
+    assert_eq!((m("glass").model, m("glass").ior), (MaterialModel::Dielectric { alpha: 0.0 }, 1.33));
+    // pbrt-v4 maps roughness to alpha = sqrt(roughness) unless told not to.
+    assert_eq!((m("frosted").model, m("frosted").ior), (MaterialModel::Dielectric { alpha: 0.3f32.sqrt() }, 1.5));
+    assert_eq!(m("raw").model, MaterialModel::Dielectric { alpha: 0.2 });
+    // A conductor given its reflectance r: eta = 1, k = 2 sqrt(r / (1 - r)) = 6 for r = 0.9, whose
+    // normal-incidence reflectance k^2 / (4 + k^2) is r again.
+    let MaterialModel::Conductor { eta, k, alpha } = m("chrome").model else { panic!("{:?}", m("chrome").model) };
+    assert!(eta == Vec3::ONE && close(k, Vec3::splat(6.0), 1e-5) && alpha == 0.0, "{eta} {k}");
+    // Named spectra: gold's reflectance (red above green above blue), roughness 0.01 as alpha 0.1.
+    let MaterialModel::Conductor { k, alpha, .. } = m("gold").model else { panic!("{:?}", m("gold").model) };
+    assert!(k.x > k.y && k.y > k.z && (alpha - 0.1).abs() < 1e-6, "{k} {alpha}");
+    // Explicit indices are kept; two roughness axes become their mean alpha, (0.2 + 0.4) / 2.
+    let MaterialModel::Conductor { eta, k, alpha } = m("brushed").model else { panic!() };
+    assert!(eta == Vec3::new(0.2, 0.9, 1.1) && k == Vec3::new(3.9, 2.4, 2.1) && (alpha - 0.3).abs() < 1e-6);
+    assert_eq!((m("coat").model, m("coat").ior), (MaterialModel::CoatedDiffuse { alpha: 0.0 }, 1.5));
     assert_eq!(m("coat").diffuse, Vec3::new(0.5, 0.2, 0.1));
+    // The classic fields keep a stand-in for the Whitted integrator.
     assert!((m("coat").reflectivity - 0.04).abs() < 1e-6, "the coat's Fresnel reflectance at normal incidence");
+    assert_eq!((m("glass").transparency, m("glass").diffuse), (1.0, Vec3::ZERO));
     // NamedMaterial may come before its definition, as in pbrt-v4.
-    assert_eq!(s.materials[s.objects[0].material as usize].diffuse, Vec3::splat(0.5));
+    let later = &s.materials[s.objects[0].material as usize];
+    assert_eq!((later.model, later.diffuse), (MaterialModel::Classic, Vec3::splat(0.5)));
     let said = |name: &str, what: &str| {
         s.warnings
             .iter()
             .any(|w| w.contains(&format!("material \"{name}\"")) && w.contains(what) && w.contains("test.pbrt:"))
     };
-    assert!(said("frosted", "approximated: ") && said("frosted", "rough dielectric"), "{:?}", s.warnings);
-    assert!(said("coat", "approximated: ") && said("chrome", "mirror"), "{:?}", s.warnings);
-    assert!(!said("glass", ""), "smooth glass is exact: {:?}", s.warnings);
+    assert!(said("coat", "approximated: ") && said("coat", "coateddiffuse"), "{:?}", s.warnings);
+    assert!(said("brushed", "anisotropic roughness"), "{:?}", s.warnings);
+    assert!(said("gold", "metal-Au-eta") && said("gold", "approximated: "), "{:?}", s.warnings);
+    for exact in ["glass", "frosted", "chrome", "raw"] {
+        assert!(!said(exact, ""), "{exact} is rendered as pbrt defines it: {:?}", s.warnings);
+    }
+}
+
+#[test]
+fn samplers_follow_the_sampler_directive() {
+    let with = |sampler: &str| scene(&format!("{sampler}\nWorldBegin\nShape \"sphere\"\n"));
+    // pbrt-v4's default is zsobol: a low-discrepancy sampler, as englobe's Sobol one.
+    assert_eq!(with("").image.sampler, SamplerKind::Sobol);
+    assert_eq!(with("Sampler \"zsobol\"").image.sampler, SamplerKind::Sobol);
+    let independent = with("Sampler \"independent\" \"integer pixelsamples\" 4 \"integer seed\" 7");
+    assert_eq!(
+        (independent.image.sampler, independent.image.samples, independent.image.seed),
+        (SamplerKind::Independent, 4, 7)
+    );
+    let halton = with("Sampler \"halton\"");
+    assert_eq!(halton.image.sampler, SamplerKind::Sobol);
+    assert!(
+        halton.warnings.iter().any(|w| w.contains("test.pbrt:1:1: approximated: ") && w.contains("halton")),
+        "{:?}",
+        halton.warnings
+    );
 }
 
 #[test]

@@ -2,7 +2,7 @@
 //! every block that has not converged takes the next pass, and so on (see [`super::estimator`]).
 //!
 //! Why the result does not depend on threads or on the window: a pixel draws its samples from its
-//! own generator ([`crate::render::pixel_rng`]), kept between passes, so sample `k` of a pixel is
+//! own sampler ([`crate::sampler::PixelSampler`]), kept between passes, so sample `k` of a pixel is
 //! the same whatever else is rendered; a pass's samples are added to a copy of each block's sums
 //! and only committed once the whole pass is done; and a block's decision, taken between passes,
 //! reads its own pixels alone. A pixel's value is the mean of its own samples, added in order, so
@@ -17,20 +17,20 @@ use std::sync::atomic::Ordering;
 use std::time::Instant;
 
 use englobe::{Counters, NoCount, Vec3, WorkCounts};
-use rand_pcg::Pcg32;
 use rayon::prelude::*;
 
 use super::estimator::{AdaptiveSampling, BLOCK_SIZE, HalfSums, block_error};
 use crate::cost::CostImage;
 use crate::film::Film;
-use crate::render::{RenderError, RenderOutput, Renderer, TILE_SIZE, pixel_rng};
+use crate::render::{RenderError, RenderOutput, Renderer, TILE_SIZE};
+use crate::sampler::PixelSampler;
 use crate::stats::{RenderStats, Tally};
 use crate::tile::PixelWindow;
 
 /// One pixel's state between passes.
 #[derive(Clone)]
 struct PixelState {
-    rng: Pcg32,
+    rng: PixelSampler,
     sums: HalfSums,
     /// Nodes visited plus exact tests over its samples (kept when the cost AOV is recorded).
     cost: u64,
@@ -111,13 +111,12 @@ impl Renderer<'_> {
         let start = Instant::now();
         let (camera, integrator) = self.parts();
         let window = self.window.unwrap_or(PixelWindow::full(self.width, self.height));
-        let seed = self.scene.image.seed;
         let mut blocks: Vec<Block> = covering_blocks(window, self.width, self.height)
             .into_iter()
             .map(|area| {
                 let pixels = (area.y0..area.y1)
                     .flat_map(|y| (area.x0..area.x1).map(move |x| (x, y)))
-                    .map(|(x, y)| PixelState { rng: pixel_rng(seed, x, y), sums: HalfSums::default(), cost: 0 })
+                    .map(|(x, y)| PixelState { rng: self.pixel_sampler(x, y), sums: HalfSums::default(), cost: 0 })
                     .collect();
                 Block { area, pixels, taken: 0, done: false }
             })

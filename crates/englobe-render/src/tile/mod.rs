@@ -5,7 +5,7 @@
 //!
 //! The design follows pbrt-v4's `--pixelbounds` and `imgtool assemble`: a piece holds exactly the
 //! values a full render gives its pixels (every pixel's samples depend on the seed and the pixel
-//! alone, see [`crate::render::pixel_rng`]), so assembling the pieces gives the full image bit for
+//! alone, see [`crate::sampler::PixelSampler`]), so assembling the pieces gives the full image bit for
 //! bit. What pbrt leaves to the user, englobe checks: every tile names the scene it was rendered
 //! from (a digest of the scene, its meshes and the options, see [`crate::digest`]) and englobe's
 //! version, and assembly refuses tiles of different renders, overlaps and gaps.

@@ -1,17 +1,28 @@
 //! pbrt materials (`Material`, `MakeNamedMaterial`, `NamedMaterial`) as englobe materials.
 //!
-//! All of the mapping is [`Builder::classic_material`], one arm per pbrt material type: englobe's
-//! material today is the classic one (a Lambertian colour, a Blinn-Phong highlight for point and
-//! distant lights, a mirror share and a smooth dielectric share with Fresnel), so a smooth
-//! `dielectric` and a `diffuse` material are exact, and the rest is the nearest classic material,
-//! reported with the material's name and place and what was approximated. When englobe gains
-//! microfacet BSDFs, the arms of the rough materials are where they go.
+//! All of the mapping is [`Builder::classic_material`], one arm per pbrt material type. pbrt-v4's
+//! four common materials reach the path tracer's BSDFs (`englobe_render::bsdf`): `diffuse` is a
+//! Lambertian (the classic model's diffuse lobe, exact), `conductor` a
+//! [`MaterialModel::Conductor`] (the exact Fresnel equations of its complex index, Trowbridge-Reitz
+//! microfacets when rough), `dielectric` a [`MaterialModel::Dielectric`] (smooth, or Walter et
+//! al. 2007's rough dielectric), and `coateddiffuse` a [`MaterialModel::CoatedDiffuse`]: the
+//! renderer's plastic BSDF, a deterministic stand-in for pbrt-v4's stochastic layered BSDF
+//! (Guo et al. 2018, "Position-Free Monte Carlo Simulation for Arbitrary Layered BSDFs"),
+//! reported as an approximation. Those materials keep a classic stand-in in their classic fields
+//! for the Whitted integrator. The other types are the nearest classic material, reported with
+//! the material's name and place and what was approximated.
 //!
 //! Roughness follows pbrt-v4: `uroughness` and `vroughness` default to `roughness`, and with
 //! `remaproughness` (the default) the microfacet `alpha` is `sqrt(roughness)`
 //! (`TrowbridgeReitzDistribution::RoughnessToAlpha`); a surface with `alpha < 0.001` is smooth
-//! (`EffectivelySmooth`). pbrt-v3's materials (`matte`, `plastic`, `mirror`, `glass`, `metal`,
-//! `substrate`) are read too, with pbrt-v3's remapping (a polynomial in `ln roughness`).
+//! (`EffectivelySmooth`). Two different axes are rendered isotropic with their mean, reported.
+//! pbrt-v3's materials (`matte`, `plastic`, `mirror`, `glass`, `metal`, `substrate`) are read too,
+//! with pbrt-v3's remapping (a polynomial in `ln roughness`).
+//!
+//! Named metal spectra (`metal-Au-eta`, ...) are reduced to an RGB reflectance at normal
+//! incidence (the table below) and given, as pbrt-v4 does for a conductor's `reflectance`, the
+//! index `eta = 1`, `k = 2 sqrt(r) / sqrt(1 - r)`, whose normal-incidence Fresnel reflectance is
+//! exactly `r`; the angular shape of the real metal's Fresnel curve is approximated.
 
 use englobe::Vec3;
 
@@ -19,6 +30,7 @@ use super::builder::{Builder, MatRef};
 use super::params::{Params, Type, Values};
 use super::source::{Place, Res, fail};
 use super::values::{Role, default_material};
+use crate::MaterialModel;
 use crate::model::{Material, MaterialId};
 
 /// A black, non-reflecting material with the given parts set afterwards.
@@ -70,6 +82,25 @@ fn named_metal_f0(name: &str) -> Option<Vec3> {
 fn v3_alpha(roughness: f64) -> f64 {
     let x = roughness.max(1e-3).ln();
     1.62142 + 0.819955 * x + 0.1734 * x * x + 0.0171201 * x.powi(3) + 0.000640711 * x.powi(4)
+}
+
+/// pbrt-v4's index for a conductor given by its reflectance `r` at normal incidence
+/// (`ConductorMaterial`): `eta = 1`, `k = 2 sqrt(r) / sqrt(1 - r)`, whose normal-incidence
+/// Fresnel reflectance `k^2 / (4 + k^2)` is `r`. `r` is kept below 0.999 so that `k` is finite.
+fn reflectance_index(r: Vec3) -> (Vec3, Vec3) {
+    let r = r.clamp(Vec3::ZERO, Vec3::splat(0.999));
+    (Vec3::ONE, 2.0 * r.map(f32::sqrt) / (Vec3::ONE - r).map(f32::sqrt))
+}
+
+/// The classic material that stands in for a conductor of normal-incidence reflectance `f0` and
+/// roughness `alpha` in the Whitted integrator: an untinted mirror when nearly smooth, else a
+/// diffuse colour with a Blinn-Phong highlight.
+fn classic_conductor(f0: Vec3, alpha: f64) -> Material {
+    if alpha < MIRROR_ALPHA {
+        Material { reflectivity: (f0.element_sum() / 3.0).min(1.0), ..black() }
+    } else {
+        Material { diffuse: f0, specular: f0, shininess: phong_exponent(alpha), ..black() }
+    }
 }
 
 impl Builder {
@@ -140,7 +171,16 @@ impl Builder {
                 (true, true) => v3_alpha(x),
             }
         };
-        Ok(0.5 * (to_alpha(u) + to_alpha(v)))
+        let (au, av) = (to_alpha(u), to_alpha(v));
+        if (au - av).abs() > 1e-6 {
+            let at = params
+                .at_or(&format!("{prefix}uroughness"), params.at_or(&format!("{prefix}vroughness"), Place::START));
+            let mean = 0.5 * (au + av);
+            self.report.approximated(at, &format!("anisotropic {what} {au} {av}"), || {
+                format!("{what}: anisotropic roughness (alpha {au:.3} along u, {av:.3} along v) is rendered isotropic, alpha {mean:.3}")
+            })?;
+        }
+        Ok(0.5 * (au + av))
     }
 
     /// A refractive index: a float, or a spectrum at 550 nm.
@@ -152,11 +192,13 @@ impl Builder {
         Ok(eta)
     }
 
-    /// A conductor's reflectance at normal incidence: its `reflectance`, or from its `eta` and
-    /// `k` (named pbrt spectra through [`named_metal_f0`]); copper by default, as in pbrt.
-    fn metal_f0(&mut self, params: &Params, prefix: &str, what: &str) -> Res<Vec3> {
+    /// A conductor's complex index `(eta, k)` per channel: from its `reflectance` (through
+    /// [`reflectance_index`], as pbrt-v4 does), or its `eta` and `k` (named pbrt spectra through
+    /// [`named_metal_f0`]); copper by default, as in pbrt.
+    fn metal_index(&mut self, params: &Params, prefix: &str, what: &str) -> Res<(Vec3, Vec3)> {
+        let copper = || reflectance_index(named_metal_f0("metal-Cu-eta").expect("copper is in the table"));
         if let Some(r) = self.color(params, &format!("{prefix}reflectance"), Role::Reflectance, what)? {
-            return Ok(r);
+            return Ok(reflectance_index(r));
         }
         let (eta_name, k_name) = (format!("{prefix}eta"), format!("{prefix}k"));
         let named = |p: Option<&super::params::Param>| match p.map(|p| &p.values) {
@@ -165,18 +207,27 @@ impl Builder {
         };
         let eta_spectrum = params.get(&eta_name, &[Type::Rgb, Type::Spectrum, Type::Float])?;
         if eta_spectrum.is_none() && !params.has(&k_name) {
-            return Ok(named_metal_f0("metal-Cu-eta").expect("copper is in the table"));
+            return Ok(copper());
         }
         if let Some(name) = named(eta_spectrum) {
             params.touch(&k_name);
             return match named_metal_f0(&name) {
-                Some(f0) => Ok(f0),
+                Some(f0) => {
+                    let at = eta_spectrum.map_or(Place::START, |p| p.at);
+                    self.report.approximated(at, &format!("metal {name} {what}"), || {
+                        format!(
+                            "{what}: the spectrum \"{name}\" is rendered as its RGB reflectance at normal incidence \
+                             {f0} (the angular shape of its Fresnel curve is approximated)"
+                        )
+                    })?;
+                    Ok(reflectance_index(f0))
+                }
                 None => {
                     let at = eta_spectrum.map_or(Place::START, |p| p.at);
                     self.report.skipped(at, &format!("metal {name}"), || {
                         format!("{what}: the spectrum \"{name}\" is not known: copper is used")
                     })?;
-                    Ok(named_metal_f0("metal-Cu-eta").expect("copper is in the table"))
+                    Ok(copper())
                 }
             };
         }
@@ -185,7 +236,7 @@ impl Builder {
             _ => self.color(params, &eta_name, Role::Unbounded, what)?.unwrap_or(Vec3::splat(0.2)),
         };
         let k = self.color(params, &k_name, Role::Unbounded, what)?.unwrap_or(Vec3::splat(3.9));
-        Ok(conductor_f0(eta, k))
+        Ok((eta.max(Vec3::splat(1e-3)), k.max(Vec3::ZERO)))
     }
 
     /// The englobe material nearest to pbrt material `kind` with `params`; `None` for pbrt's
@@ -217,15 +268,6 @@ impl Builder {
                 let eta =
                     if params.has("index") { self.eta(params, "index", what)? } else { self.eta(params, "eta", what)? };
                 let alpha = self.alpha(params, what, "", 0.0, kind == "glass")?;
-                if alpha >= SMOOTH_ALPHA {
-                    approx(
-                        self,
-                        "rough dielectric",
-                        format!(
-                            "{what}: a rough dielectric (alpha {alpha:.3}) is rendered as smooth glass of index {eta}"
-                        ),
-                    )?;
-                }
                 if kind == "glass" {
                     let kr = self.color(params, "Kr", Role::Reflectance, what)?.unwrap_or(Vec3::ONE);
                     let kt = self.color(params, "Kt", Role::Reflectance, what)?.unwrap_or(Vec3::ONE);
@@ -233,7 +275,13 @@ impl Builder {
                         approx(self, "glass tint", format!("{what}: Kr {kr} and Kt {kt} are rendered as 1"))?;
                     }
                 }
-                Material { transparency: 1.0, ior: eta as f32, ..black() }
+                // The classic fields: Whitted's smooth glass.
+                Material {
+                    transparency: 1.0,
+                    ior: eta as f32,
+                    model: MaterialModel::Dielectric { alpha: alpha as f32 },
+                    ..black()
+                }
             }
             "thindielectric" => {
                 let eta = self.eta(params, "eta", what)?;
@@ -250,11 +298,19 @@ impl Builder {
                 )?;
                 Material { reflectivity: r, transparency: 1.0 - r, ior: 1.0, ..black() }
             }
-            "conductor" | "metal" | "coatedconductor" => {
+            "conductor" | "metal" | "coatedconductor" | "mirror" => {
                 let prefix = if kind == "coatedconductor" { "conductor." } else { "" };
-                let f0 = self.metal_f0(params, prefix, what)?;
-                let alpha =
-                    self.alpha(params, what, prefix, if kind == "metal" { 0.01 } else { 0.0 }, kind == "metal")?;
+                let (eta, k, alpha) = if kind == "mirror" {
+                    // pbrt-v3's mirror: a smooth conductor reflecting Kr at every angle but
+                    // grazing ones (pbrt-v3 used a constant Fresnel of Kr).
+                    let kr = self.color(params, "Kr", Role::Reflectance, what)?.unwrap_or(Vec3::splat(0.9));
+                    let (eta, k) = reflectance_index(kr);
+                    (eta, k, 0.0)
+                } else {
+                    let (eta, k) = self.metal_index(params, prefix, what)?;
+                    let default_roughness = if kind == "metal" { 0.01 } else { 0.0 };
+                    (eta, k, self.alpha(params, what, prefix, default_roughness, kind == "metal")?)
+                };
                 if kind == "coatedconductor" {
                     for p in [
                         "interface.eta",
@@ -269,67 +325,49 @@ impl Builder {
                     ] {
                         params.touch(p);
                     }
-                }
-                let coat = if kind == "coatedconductor" { " (its dielectric coat is left out)" } else { "" };
-                if alpha < MIRROR_ALPHA {
-                    let reflectivity = f0.element_sum() / 3.0;
                     approx(
                         self,
-                        "conductor",
+                        "conductor coat",
                         format!(
-                            "{what}: a conductor{} of normal-incidence reflectance {f0} is rendered as an untinted \
-                         mirror of reflectivity {reflectivity:.3}{coat}",
-                            if alpha >= SMOOTH_ALPHA {
-                                format!(" of roughness alpha {alpha:.3}")
-                            } else {
-                                String::new()
-                            }
+                            "{what}: the dielectric coat of a coated conductor is left out: rendered as the bare conductor"
                         ),
                     )?;
-                    Material { reflectivity: reflectivity.min(1.0), ..black() }
-                } else {
-                    approx(
-                        self,
-                        "rough conductor",
-                        format!(
-                            "{what}: a rough conductor (alpha {alpha:.3}) is rendered as a diffuse colour {f0} with a \
-                         Blinn-Phong highlight from point and distant lights{coat}"
-                        ),
-                    )?;
-                    Material { diffuse: f0, specular: f0, shininess: phong_exponent(alpha), ..black() }
+                }
+                let mut m = classic_conductor(conductor_f0(eta, k), alpha);
+                m.model = MaterialModel::Conductor { eta, k, alpha: alpha as f32 };
+                m
+            }
+            "coateddiffuse" => {
+                let base = self.color(params, "reflectance", Role::Reflectance, what)?.unwrap_or(Vec3::splat(0.5));
+                let eta = self.eta(params, "eta", what)?;
+                let alpha = self.alpha(params, what, "", 0.0, false)?;
+                for p in ["thickness", "g", "maxdepth", "nsamples"] {
+                    params.touch(p);
+                }
+                if self.color(params, "albedo", Role::Reflectance, what)?.is_some_and(|a| a != Vec3::ZERO) {
+                    approx(self, "coat albedo", format!("{what}: the medium inside the coat (albedo) is left out"))?;
+                }
+                approx(
+                    self,
+                    "coated diffuse",
+                    format!(
+                        "{what}: pbrt's layered coateddiffuse is rendered as a Lambertian base {base} under a GGX coat \
+                         of index {eta} and alpha {alpha:.3} coupled by albedo scaling (Schlick's Fresnel; the base \
+                         does not darken through bounces inside the coat)"
+                    ),
+                )?;
+                // The classic fields: the base under a fixed mirror share (Whitted).
+                let reflectivity = dielectric_f0(eta) as f32;
+                Material {
+                    diffuse: base,
+                    reflectivity: reflectivity.min(1.0),
+                    ior: eta as f32,
+                    model: MaterialModel::CoatedDiffuse { alpha: alpha as f32 },
+                    ..black()
                 }
             }
-            "mirror" => {
-                let kr = self.color(params, "Kr", Role::Reflectance, what)?.unwrap_or(Vec3::splat(0.9));
-                let reflectivity = kr.element_sum() / 3.0;
-                if kr.max_element() - kr.min_element() > 1e-6 {
-                    approx(
-                        self,
-                        "mirror tint",
-                        format!("{what}: the tinted mirror Kr {kr} is rendered untinted, {reflectivity:.3}"),
-                    )?;
-                }
-                Material { reflectivity, ..black() }
-            }
-            "coateddiffuse" | "plastic" | "substrate" => {
+            "plastic" | "substrate" => {
                 let (base, spec, alpha) = match kind {
-                    "coateddiffuse" => {
-                        let base =
-                            self.color(params, "reflectance", Role::Reflectance, what)?.unwrap_or(Vec3::splat(0.5));
-                        let eta = self.eta(params, "eta", what)?;
-                        let alpha = self.alpha(params, what, "", 0.0, false)?;
-                        for p in ["thickness", "g", "maxdepth", "nsamples"] {
-                            params.touch(p);
-                        }
-                        if self.color(params, "albedo", Role::Reflectance, what)?.is_some_and(|a| a != Vec3::ZERO) {
-                            approx(
-                                self,
-                                "coat albedo",
-                                format!("{what}: the medium inside the coat (albedo) is left out"),
-                            )?;
-                        }
-                        (base, Vec3::splat(dielectric_f0(eta) as f32), alpha)
-                    }
                     "plastic" => {
                         let kd = self.color(params, "Kd", Role::Reflectance, what)?.unwrap_or(Vec3::splat(0.25));
                         let ks = self.color(params, "Ks", Role::Reflectance, what)?.unwrap_or(Vec3::splat(0.25));

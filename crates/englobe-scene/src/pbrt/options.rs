@@ -15,7 +15,7 @@ use glam::{DMat3, DVec3};
 use super::builder::{Builder, Decl};
 use super::params::Params;
 use super::source::{Place, Res, fail};
-use crate::model::{Camera, ImageSettings, IntegratorKind, MAX_DEPTH, Projection};
+use crate::model::{Camera, ImageSettings, IntegratorKind, MAX_DEPTH, Projection, SamplerKind};
 use crate::pixel_filter::PixelFilter;
 
 impl Builder {
@@ -55,7 +55,7 @@ impl Builder {
         let film_at = self.film.as_ref().map_or(Place::START, |d| d.at);
         let sampler_at = self.sampler.as_ref().map_or(film_at, |d| d.at);
         let (width, height) = self.film_size()?;
-        let (samples, seed) = self.sampler_options()?;
+        let (samples, seed, sampler) = self.sampler_options()?;
         let max_depth = self.integrator_options()?;
         let filter = self.pixel_filter()?;
         if let Err(message) = ImageSettings::check_limits(width, height, samples, max_depth) {
@@ -72,6 +72,7 @@ impl Builder {
             background: self.background,
             ambient: Vec3::ZERO,
             seed: self.option_seed.unwrap_or(seed),
+            sampler,
             integrator: IntegratorKind::Path,
             filter,
             clamp: None,
@@ -140,8 +141,12 @@ impl Builder {
         Ok((width, height))
     }
 
-    fn sampler_options(&mut self) -> Res<(u32, u64)> {
-        let Some(d) = self.sampler.take() else { return Ok((16, 0)) };
+    /// Samples per pixel, seed and sampler. pbrt-v4's default, `zsobol`, and its other Sobol
+    /// samplers are englobe's Sobol sampler (Owen-scrambled, padded per pixel: pbrt's
+    /// `paddedsobol`); `independent` is the independent one; the stratified, Halton and PMJ02BN
+    /// samplers, low-discrepancy too, are rendered with the Sobol one, reported.
+    fn sampler_options(&mut self) -> Res<(u32, u64, SamplerKind)> {
+        let Some(d) = self.sampler.take() else { return Ok((16, 0, SamplerKind::Sobol)) };
         let what = format!("Sampler \"{}\"", d.kind);
         let samples = if d.kind == "stratified" {
             let x = d.params.integer("xsamples")?.unwrap_or(4);
@@ -157,14 +162,22 @@ impl Builder {
         };
         let seed = d.params.integer("seed")?.unwrap_or(0) as u64;
         d.params.touch("randomization");
-        if d.kind != "independent" {
-            let kind = d.kind.clone();
-            self.report.ignored(d.at, "sampler type", || {
-                format!("{what}: englobe draws independent uniform samples, not \"{kind}\" ones: the same picture with other noise")
-            })?;
-        }
+        let sampler = match d.kind.as_str() {
+            "independent" => SamplerKind::Independent,
+            "sobol" | "zsobol" | "paddedsobol" => SamplerKind::Sobol,
+            _ => {
+                let kind = d.kind.clone();
+                self.report.approximated(d.at, "sampler type", || {
+                    format!(
+                        "{what}: englobe draws Owen-scrambled Sobol samples, not \"{kind}\" ones: the same picture \
+                         with other noise"
+                    )
+                })?;
+                SamplerKind::Sobol
+            }
+        };
         self.report_unused(&d.params, &format!("Sampler {}", d.kind), &what)?;
-        Ok((samples, seed))
+        Ok((samples, seed, sampler))
     }
 
     fn integrator_options(&mut self) -> Res<u32> {
