@@ -25,7 +25,12 @@ use rand_pcg::Pcg32;
 /// The independent sample generator of one pixel: depends on the seed and the pixel only, never
 /// on threads.
 pub fn pixel_rng(seed: u64, x: u32, y: u32) -> Pcg32 {
-    Pcg32::seed_from_u64(seed ^ ((y as u64) << 32 | x as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15))
+    Pcg32::seed_from_u64(pixel_seed(seed, x, y))
+}
+
+/// The seed of pixel `(x, y)`'s stream.
+fn pixel_seed(seed: u64, x: u32, y: u32) -> u64 {
+    seed ^ ((y as u64) << 32 | x as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15)
 }
 
 /// The random numbers of one pixel.
@@ -33,6 +38,9 @@ pub fn pixel_rng(seed: u64, x: u32, y: u32) -> Pcg32 {
 pub enum PixelSampler {
     /// Independent uniform numbers from the pixel's PCG32 stream ([`pixel_rng`]).
     Independent(Pcg32),
+    /// The same stream before its first number, seeded when one is drawn: Whitted's integrator
+    /// at one sample per pixel draws none, and seeding costs as much as a ray's setup.
+    Unseeded(u64),
     /// Owen-scrambled padded Sobol points.
     Sobol(SobolPixel),
 }
@@ -51,13 +59,25 @@ impl PixelSampler {
     /// The sampler of pixel `(x, y)` for the scene's `seed`.
     pub fn new(kind: SamplerKind, seed: u64, x: u32, y: u32) -> PixelSampler {
         match kind {
-            SamplerKind::Independent => PixelSampler::Independent(pixel_rng(seed, x, y)),
+            SamplerKind::Independent => PixelSampler::Unseeded(pixel_seed(seed, x, y)),
             SamplerKind::Sobol => PixelSampler::Sobol(SobolPixel {
                 seed: sobol::mix(sobol::mix(seed) ^ (u64::from(y) << 32 | u64::from(x))),
                 next_sample: 0,
                 sample: 0,
                 dimension: 0,
             }),
+        }
+    }
+
+    /// The independent stream, seeded now if it was not yet (only for independent samplers).
+    #[inline]
+    fn seeded(&mut self) -> &mut Pcg32 {
+        if let PixelSampler::Unseeded(seed) = *self {
+            *self = PixelSampler::Independent(Pcg32::seed_from_u64(seed));
+        }
+        match self {
+            PixelSampler::Independent(rng) => rng,
+            _ => unreachable!("only independent samplers have a stream"),
         }
     }
 
@@ -80,6 +100,7 @@ impl TryRng for PixelSampler {
     fn try_next_u32(&mut self) -> Result<u32, Infallible> {
         Ok(match self {
             PixelSampler::Independent(rng) => rng.next_u32(),
+            PixelSampler::Unseeded(_) => self.seeded().next_u32(),
             PixelSampler::Sobol(s) => {
                 let x = sobol::scrambled_sobol(s.sample, s.dimension, s.seed);
                 s.dimension = s.dimension.wrapping_add(1);
@@ -94,6 +115,7 @@ impl TryRng for PixelSampler {
     fn try_next_u64(&mut self) -> Result<u64, Infallible> {
         Ok(match self {
             PixelSampler::Independent(rng) => rng.next_u64(),
+            PixelSampler::Unseeded(_) => self.seeded().next_u64(),
             PixelSampler::Sobol(s) => {
                 let high = u64::from(sobol::scrambled_sobol(s.sample, s.dimension, s.seed));
                 let low = sobol::mix(s.seed ^ (u64::from(s.sample) << 32 | u64::from(s.dimension))) >> 32;
@@ -104,8 +126,8 @@ impl TryRng for PixelSampler {
     }
 
     fn try_fill_bytes(&mut self, dst: &mut [u8]) -> Result<(), Infallible> {
-        if let PixelSampler::Independent(rng) = self {
-            rng.fill_bytes(dst);
+        if let PixelSampler::Independent(_) | PixelSampler::Unseeded(_) = self {
+            self.seeded().fill_bytes(dst);
             return Ok(());
         }
         for chunk in dst.chunks_mut(4) {
