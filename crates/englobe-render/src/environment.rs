@@ -91,11 +91,8 @@ impl EnvironmentLight {
             Sky::Map(map) => {
                 let (w, h) = (map.width as usize, map.height as usize);
                 let means = pixel_means(&map.pixels.iter().map(|&p| luminance(p)).collect::<Vec<_>>(), w, h);
-                let weights: Vec<f32> = means
-                    .iter()
-                    .enumerate()
-                    .map(|(i, m)| m * (PI * ((i / w) as f32 + 0.5) / h as f32).sin())
-                    .collect();
+                let weights: Vec<f32> =
+                    means.iter().enumerate().map(|(i, m)| m * (PI * ((i / w) as f32 + 0.5) / h as f32).sin()).collect();
                 (w, h, weights)
             }
             sky => {
@@ -376,7 +373,8 @@ mod tests {
         // One lit pixel in the dark, at the left edge so that its light wraps to the right edge,
         // and one on the top row: the bilinear lookup spreads each over half of its neighbours,
         // and the sampling table covers all of that.
-        let env = map_env(16, 8, |x, y| if (x, y) == (0, 4) || (x, y) == (9, 0) { Vec3::ONE } else { Vec3::ZERO }, 20.0);
+        let env =
+            map_env(16, 8, |x, y| if (x, y) == (0, 4) || (x, y) == (9, 0) { Vec3::ONE } else { Vec3::ZERO }, 20.0);
         let light = EnvironmentLight::new(&env);
         let (mut lit, mut dark) = (0, 0);
         for i in 0..400 {

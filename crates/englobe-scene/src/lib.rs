@@ -28,6 +28,7 @@ pub mod texture;
 
 pub use environment::{Environment, EnvironmentMap, Sky};
 pub use error::{Located, SceneError};
+pub use load_observer::{LoadObserver, Unobserved};
 pub use material::{
     Alpha, AlphaMode, Channel, MaterialModel, MaterialTextures, NormalEncoding, NormalMap, ScalarTexture, TextureRef,
     UvTransform,
@@ -38,7 +39,6 @@ pub use model::{
     OutputSettings, Projection, Scene, SceneObject, ToneMap,
 };
 pub use overrides::Override;
-pub use load_observer::{LoadObserver, Unobserved};
 pub use parse::{
     DEFAULT_MATERIAL, load_scene, load_scene_observed, load_scene_with, parse_scene, parse_scene_observed,
     parse_scene_with,

@@ -314,7 +314,8 @@ impl Material {
     /// light. A transmitting one keeps its back faces, since light leaves its inside through
     /// them.
     pub fn culls_back_faces(&self) -> bool {
-        let transmits = matches!(self.model, MaterialModel::MetallicRoughness { transmission, .. } if transmission > 0.0);
+        let transmits =
+            matches!(self.model, MaterialModel::MetallicRoughness { transmission, .. } if transmission > 0.0);
         !self.double_sided && !transmits && self.transparency <= 0.0
     }
 }

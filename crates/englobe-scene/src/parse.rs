@@ -11,8 +11,8 @@ use toml::Spanned;
 use toml::de::DeTable;
 
 use crate::error::{Located, SceneError};
-use crate::load_observer::{LoadObserver, Unobserved};
 use crate::format::{CameraDef, FilterRadius, ImageDef, ProjectionKind, SceneFile};
+use crate::load_observer::{LoadObserver, Unobserved};
 use crate::model::{Camera, ImageSettings, Light, MaterialId, Projection, Scene, SceneObject};
 use crate::overrides::{Override, Placed};
 use crate::pixel_filter::{MAX_FILTER_RADIUS, PixelFilter};

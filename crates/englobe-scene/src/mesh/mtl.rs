@@ -54,7 +54,8 @@ pub(super) fn scan(path: &Path, text: &str) -> Result<MtlScan, MeshFileError> {
             }
             "newmtl" => current = Some(rest.to_owned()),
             "Ka" | "Kd" | "Ks" | "Ke" | "Tf" => {
-                let color = parse_color(rest).map_err(|e| err(MeshErrorKind::Malformed(format!("`{keyword}`: {e}"))))?;
+                let color =
+                    parse_color(rest).map_err(|e| err(MeshErrorKind::Malformed(format!("`{keyword}`: {e}"))))?;
                 rewritten = Some(match color {
                     MtlColor::Rgb(c) => format!("{keyword} {} {} {}", c.x, c.y, c.z),
                     MtlColor::Spectral { file, .. } => {
@@ -142,13 +143,10 @@ mod tests {
         .unwrap();
         let lines: Vec<&str> = s.text.lines().collect();
         assert_eq!(lines.len(), 8);
-        assert_eq!((lines[1], lines[3], lines[4], lines[5], lines[6]), (
-            "Kd 0.5 0.5 0.5",
-            "",
-            "# Ka spectral",
-            "Tf 0.1 0.2 0.3",
-            "d 0.4"
-        ));
+        assert_eq!(
+            (lines[1], lines[3], lines[4], lines[5], lines[6]),
+            ("Kd 0.5 0.5 0.5", "", "# Ka spectral", "Tf 0.1 0.2 0.3", "d 0.4")
+        );
         assert!(lines[2].starts_with("Ks 0.60"), "{}", lines[2]);
         assert_eq!(s.warnings.len(), 2, "{:?}", s.warnings);
         assert!(s.warnings[0].starts_with("t.mtl:5: `Ka spectral r.rfl`"), "{:?}", s.warnings);

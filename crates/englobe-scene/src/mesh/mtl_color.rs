@@ -29,8 +29,7 @@ pub(super) enum MtlColor {
 }
 
 /// CIE XYZ to linear sRGB (IEC 61966-2-1, the inverse of its RGB-to-XYZ matrix), rows.
-const XYZ_TO_RGB: [[f32; 3]; 3] =
-    [[3.2406, -1.5372, -0.4986], [-0.9689, 1.8758, 0.0415], [0.0557, -0.2040, 1.0570]];
+const XYZ_TO_RGB: [[f32; 3]; 3] = [[3.2406, -1.5372, -0.4986], [-0.9689, 1.8758, 0.0415], [0.0557, -0.2040, 1.0570]];
 
 fn number(word: &str, what: &str) -> Result<f32, String> {
     match word.parse::<f32>() {

@@ -170,10 +170,17 @@ fn layers(l: &MtlLobes) -> Layers {
     let (kd, ks) = (l.diffuse.max_element(), l.specular.max_element());
     let glossy = shininess_to_roughness(l.shininess);
     // Index 1: no dielectric layer, so a surface without a highlight is Lambertian.
-    let lambert = Layers { base_color: l.diffuse, metallic: 0.0, roughness: glossy, ior: 1.0, metal_from_specular: false };
+    let lambert =
+        Layers { base_color: l.diffuse, metallic: 0.0, roughness: glossy, ior: 1.0, metal_from_specular: false };
     if l.transmission > 0.0 {
         let base_color = l.tint.unwrap_or(Vec3::ONE);
-        return Layers { base_color, metallic: 0.0, roughness: 0.0, ior: l.ni.unwrap_or(1.5), metal_from_specular: false };
+        return Layers {
+            base_color,
+            metallic: 0.0,
+            roughness: 0.0,
+            ior: l.ni.unwrap_or(1.5),
+            metal_from_specular: false,
+        };
     }
     if ks <= 0.0 {
         return lambert;
@@ -383,7 +390,8 @@ mod tests {
     }
 
     fn close(a: (Vec3, f32, f32, f32, f32), b: (Vec3, f32, f32, f32, f32)) -> bool {
-        (a.0 - b.0).abs().max_element() < 1e-6 && [a.1 - b.1, a.2 - b.2, a.3 - b.3, a.4 - b.4].iter().all(|d| d.abs() < 1e-6)
+        (a.0 - b.0).abs().max_element() < 1e-6
+            && [a.1 - b.1, a.2 - b.2, a.3 - b.3, a.4 - b.4].iter().all(|d| d.abs() < 1e-6)
     }
 
     #[test]
@@ -430,7 +438,11 @@ mod tests {
         assert!((metallic - 0.8).abs() < 1e-3, "Ks 1 beside Kd 0.25: {metallic}");
         // `Tf xyz` tints glass.
         let (m, _) = one("newmtl m\nTf xyz 0.5\nd 0\nillum 4\n");
-        assert!((m.diffuse - Vec3::new(0.6024, 0.4742, 0.4544).min(Vec3::ONE)).abs().max_element() < 1e-3, "{}", m.diffuse);
+        assert!(
+            (m.diffuse - Vec3::new(0.6024, 0.4742, 0.4544).min(Vec3::ONE)).abs().max_element() < 1e-3,
+            "{}",
+            m.diffuse
+        );
     }
 
     #[test]
