@@ -380,8 +380,11 @@ mod tests {
         assert_eq!(with(8).reflectivity, 0.0, "illum 8 reflects a map, not rays");
     }
 
-    /// The base colour, metalness, roughness and index of the material of `text`.
-    fn microfacet(text: &str) -> (Vec3, f32, f32, f32, f32) {
+    /// Base colour, metalness, roughness, transmission and index.
+    type Mapped = (Vec3, f32, f32, f32, f32);
+
+    /// The base colour, metalness, roughness, transmission and index of the material of `text`.
+    fn microfacet(text: &str) -> Mapped {
         let (m, _) = one(text);
         let MaterialModel::MetallicRoughness { metallic, roughness, transmission } = m.model else {
             panic!("{:?}", m.model)
@@ -389,7 +392,7 @@ mod tests {
         (m.diffuse, metallic, roughness, transmission, m.ior)
     }
 
-    fn close(a: (Vec3, f32, f32, f32, f32), b: (Vec3, f32, f32, f32, f32)) -> bool {
+    fn close(a: Mapped, b: Mapped) -> bool {
         (a.0 - b.0).abs().max_element() < 1e-6
             && [a.1 - b.1, a.2 - b.2, a.3 - b.3, a.4 - b.4].iter().all(|d| d.abs() < 1e-6)
     }
@@ -399,7 +402,7 @@ mod tests {
         let red = Vec3::new(0.6, 0.1, 0.1);
         // Ns 98: alpha = sqrt(2 / 100), roughness = alpha^(1/2).
         let r98 = (2.0f32 / 100.0).sqrt().sqrt();
-        let rows: [(&str, (Vec3, f32, f32, f32, f32)); 9] = [
+        let rows: [(&str, Mapped); 9] = [
             // Ks black: Lambert, no layer (index 1), whatever Ni says.
             ("Kd 0.6 0.1 0.1\nKs 0 0 0\nNs 98\nNi 1.5\nillum 2", (red, 0.0, r98, 0.0, 1.0)),
             // illum 1 has no highlight: Ks is not read.
