@@ -15,11 +15,11 @@ use englobe_render::tile::file::{TileHeader, VERSION, write_tile};
 use englobe_render::{HeatmapScale, PixelWindow, Renderer, TileSpec, build_world, write_cost_image, write_image_with};
 use englobe_scene::framing::{framing_scene, turntable_position};
 use englobe_scene::mesh::MeshFormat;
-use englobe_scene::{Override, Scene, load_scene_with, parse_scene_with};
+use englobe_scene::{LoadObserver, Override, Scene, Unobserved, load_scene_observed, parse_scene_with};
 
 use crate::image_options::{Balance, ImageOptions, render_digest};
 use crate::interrupt;
-use crate::progress::{Phases, progress_bar, tile_bar};
+use crate::progress::{MeshPhases, Phases, progress_bar, tile_bar};
 
 #[derive(Args, Clone)]
 pub struct RenderArgs {
@@ -115,6 +115,16 @@ pub enum CostScale {
 /// `englobe_scene::framing`, a `.pbrt` file is read as a pbrt-v4 scene, `strict` or not), or the
 /// embedded default, with `overrides` applied (refused for pbrt scenes), and its display name.
 pub fn read_scene(path: Option<&PathBuf>, overrides: &[Override], strict: bool) -> anyhow::Result<(Scene, String)> {
+    read_scene_observed(path, overrides, strict, &Unobserved)
+}
+
+/// [`read_scene`], telling `observer` when each mesh file of a scene file starts and ends loading.
+pub fn read_scene_observed(
+    path: Option<&PathBuf>,
+    overrides: &[Override],
+    strict: bool,
+    observer: &dyn LoadObserver,
+) -> anyhow::Result<(Scene, String)> {
     match path {
         Some(p) if englobe_scene::pbrt::is_pbrt_path(p) => {
             englobe_scene::pbrt::refuse_overrides(overrides)?;
@@ -131,7 +141,7 @@ pub fn read_scene(path: Option<&PathBuf>, overrides: &[Override], strict: bool) 
             let text = read_stdin()?;
             Ok((parse_scene_with(&text, STDIN_NAME.as_ref(), overrides)?, STDIN_NAME.to_owned()))
         }
-        Some(p) => Ok((load_scene_with(p, overrides)?, p.display().to_string())),
+        Some(p) => Ok((load_scene_observed(p, overrides, observer)?, p.display().to_string())),
         None => Ok((
             parse_scene_with(englobe_render::DEFAULT_SCENE, "default.toml".as_ref(), overrides)?,
             "default".to_owned(),
@@ -230,11 +240,15 @@ fn render(args: &RenderArgs, interrupted: &'static std::sync::atomic::AtomicBool
     let phases = Phases::new(args.quiet);
     let shown_name = args.scene.as_ref().map_or("the default scene".into(), |p| p.display().to_string());
     let phase = phases.begin(&format!("loading {shown_name}"));
-    let (mut scene, scene_name) = read_scene(args.scene.as_ref(), &args.image.overrides(), args.strict)?;
+    let meshes = MeshPhases::new(&phases, &phase);
+    let (mut scene, scene_name) =
+        read_scene_observed(args.scene.as_ref(), &args.image.overrides(), args.strict, &meshes)?;
+    let mesh_files = meshes.count();
     let load_seconds = phases.end(phase, |s| {
         let triangles: usize = scene.objects.iter().map(|o| o.object.triangle_count()).sum();
+        let files = if mesh_files > 0 { format!(" from {mesh_files} mesh file(s)") } else { String::new() };
         format!(
-            "loaded {shown_name} in {s:.2} s: {} objects ({triangles} triangles in the picture), {} lights",
+            "loaded {shown_name} in {s:.2} s: {} objects ({triangles} triangles in the picture{files}), {} lights",
             scene.objects.len(),
             scene.lights.len()
         )

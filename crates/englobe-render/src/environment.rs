@@ -13,11 +13,16 @@
 //! turned back by the rotation, then mapped. [`direction_to_uv`] and [`uv_to_direction`] are the
 //! two ways.
 //!
-//! **Lookups** are nearest-pixel: the radiance is constant over each pixel, exactly as the
-//! sampling density is, so that every direction whose radiance is not zero has a density that is
-//! not zero. **Densities** are with respect to solid angle: a point of density `p(u, v)` on the map
-//! has the density `p(u, v) / (2 π² sin θ)` over directions (the map covers `2π` by `π` radians,
-//! and a pixel's solid angle shrinks with `sin θ` towards the poles).
+//! **Lookups** are bilinear between the pixels' centres, wrapping across the left and right edges
+//! (the map is periodic in `φ`) and clamped at the top and bottom rows, so that a map of few
+//! pixels shades smoothly instead of in blocks. **Sampling** picks a pixel with probability
+//! proportional to the mean of that bilinear reconstruction over the pixel (the luminances of the
+//! pixel and its eight neighbours weighted `[1 6 1] / 8` along each axis: the exact integral of
+//! the tent-shaped weights over the pixel) times `sin θ`, then a point uniformly inside it. Every
+//! direction whose bilinear radiance is not zero lies in a pixel one of whose neighbours is lit,
+//! so its density is not zero either. **Densities** are with respect to solid angle: a point of
+//! density `p(u, v)` on the map has the density `p(u, v) / (2 π² sin θ)` over directions (the map
+//! covers `2π` by `π` radians, and a pixel's solid angle shrinks with `sin θ` towards the poles).
 //!
 //! A constant colour and the sky gradient are exact functions of the direction; they are sampled
 //! through a table of 64 rows (they do not depend on the azimuth) of the largest radiance in each
@@ -85,11 +90,9 @@ impl EnvironmentLight {
         let (columns, rows, weights) = match &env.sky {
             Sky::Map(map) => {
                 let (w, h) = (map.width as usize, map.height as usize);
-                let mut weights = Vec::with_capacity(w * h);
-                for y in 0..h {
-                    let sin_theta = (PI * (y as f32 + 0.5) / h as f32).sin();
-                    weights.extend(map.pixels[y * w..(y + 1) * w].iter().map(|&p| luminance(p) * sin_theta));
-                }
+                let means = pixel_means(&map.pixels.iter().map(|&p| luminance(p)).collect::<Vec<_>>(), w, h);
+                let weights: Vec<f32> =
+                    means.iter().enumerate().map(|(i, m)| m * (PI * ((i / w) as f32 + 0.5) / h as f32).sin()).collect();
                 (w, h, weights)
             }
             sky => {
@@ -144,12 +147,20 @@ impl EnvironmentLight {
         }
     }
 
-    /// The radiance at map coordinates `uv`, nearest pixel (maps only).
+    /// The radiance at map coordinates `uv`, bilinear between pixel centres (maps only).
     fn map_radiance(&self, uv: Vec2) -> Vec3 {
         let Sky::Map(map) = &self.env.sky else { unreachable!("a map's lookup") };
-        let x = ((uv.x * map.width as f32) as u32).min(map.width - 1);
-        let y = ((uv.y * map.height as f32) as u32).min(map.height - 1);
-        map.get(x, y) * self.env.intensity
+        let (w, h) = (map.width as i64, map.height as i64);
+        // Pixel centres sit at half-integers of the continuous coordinates.
+        let (px, py) = (uv.x * w as f32 - 0.5, uv.y * h as f32 - 0.5);
+        let (fx, fy) = (px - px.floor(), py - py.floor());
+        let (x0, y0) = (px.floor() as i64, py.floor() as i64);
+        let column = |x: i64| x.rem_euclid(w) as u32;
+        let row = |y: i64| y.clamp(0, h - 1) as u32;
+        let (xa, xb, ya, yb) = (column(x0), column(x0 + 1), row(y0), row(y0 + 1));
+        let top = map.get(xa, ya) * (1.0 - fx) + map.get(xb, ya) * fx;
+        let bottom = map.get(xa, yb) * (1.0 - fx) + map.get(xb, yb) * fx;
+        (top * (1.0 - fy) + bottom * fy) * self.env.intensity
     }
 
     /// A direction from two uniform numbers in `[0, 1)`, with density proportional to the
@@ -164,7 +175,7 @@ impl EnvironmentLight {
         let uv = Vec2::new(su, sv);
         let direction = self.direction(uv);
         let radiance = match &self.env.sky {
-            // The pixel that was sampled, whatever rounding the direction went through.
+            // At the point that was sampled, whatever rounding the direction went through.
             Sky::Map(_) => self.map_radiance(uv),
             sky => sky_radiance(sky, uv_to_direction(uv).y) * self.env.intensity,
         };
@@ -188,6 +199,28 @@ impl EnvironmentLight {
     pub fn table_size(&self) -> (usize, usize) {
         (self.columns, self.rows)
     }
+}
+
+/// The mean over each pixel of the bilinear reconstruction of `values` (a `w` x `h` image,
+/// wrapping across the left and right edges, clamped at the top and bottom): along each axis, the
+/// tent weights of the pixel and its two neighbours integrate over the pixel to `[1 6 1] / 8`.
+fn pixel_means(values: &[f32], w: usize, h: usize) -> Vec<f32> {
+    let smooth = |a: f32, b: f32, c: f32| (a + 6.0 * b + c) / 8.0;
+    let mut rows = vec![0.0; w * h];
+    for y in 0..h {
+        for x in 0..w {
+            let at = |x: usize| values[y * w + x];
+            rows[y * w + x] = smooth(at((x + w - 1) % w), at(x), at((x + 1) % w));
+        }
+    }
+    let mut out = vec![0.0; w * h];
+    for y in 0..h {
+        for x in 0..w {
+            let at = |y: usize| rows[y * w + x];
+            out[y * w + x] = smooth(at(y.saturating_sub(1)), at(y), at((y + 1).min(h - 1)));
+        }
+    }
+    out
 }
 
 /// The radiance of a constant or gradient sky in a direction whose `y` is given (before the
@@ -240,19 +273,29 @@ mod tests {
     }
 
     #[test]
-    fn lookups_are_nearest_pixel_and_the_rotation_turns_z_towards_x() {
-        // 4 x 2: column x, row y holds (x, y, 1).
+    fn lookups_are_bilinear_and_the_rotation_turns_z_towards_x() {
+        // 4 x 2: column x, row y holds (x, y, 1); pixel centres at u = (x + 1/2) / 4, v = (y + 1/2) / 2.
         let env = map_env(4, 2, |x, y| Vec3::new(x as f32, y as f32, 1.0), 0.0);
         let light = EnvironmentLight::new(&env);
-        // +x, slightly up: the centre column is the start of column 2, top row.
-        assert_eq!(light.radiance(Vec3::new(1.0, 0.1, 0.01)), Vec3::new(2.0, 0.0, 1.0));
-        assert_eq!(light.radiance(Vec3::new(0.0, -0.1, 1.0)), Vec3::new(3.0, 1.0, 1.0), "+z: column 3");
-        assert_eq!(light.radiance(Vec3::new(-0.01, 0.1, -1.0)), Vec3::new(0.0, 0.0, 1.0), "-z: column 0 of the map");
+        let at = |u: f32, v: f32| light.radiance(light.direction(Vec2::new(u, v)));
+        let close = |a: Vec3, b: Vec3| (a - b).abs().max_element() < 1e-4;
+        for (u, v, want, what) in [
+            (0.625, 0.25, Vec3::new(2.0, 0.0, 1.0), "the centre of pixel (2, 0)"),
+            (0.75, 0.25, Vec3::new(2.5, 0.0, 1.0), "halfway between columns 2 and 3"),
+            (0.6875, 0.5, Vec3::new(2.25, 0.5, 1.0), "a quarter of the way along, halfway down"),
+            (0.02, 0.75, Vec3::new(1.5 - 0.16 * 1.5, 1.0, 1.0), "across the left edge, columns 3 and 0"),
+            (0.625, 0.05, Vec3::new(2.0, 0.0, 1.0), "above the top row's centres: clamped"),
+            (0.625, 0.97, Vec3::new(2.0, 1.0, 1.0), "below the bottom row's centres: clamped"),
+        ] {
+            assert!(close(at(u, v), want), "{what}: {} against {want}", at(u, v));
+        }
+        // +x is the map's centre column (u = 1/2), +z a quarter to its right.
+        assert!(close(light.radiance(Vec3::X), at(0.5, 0.5)) && close(light.radiance(Vec3::Z), at(0.75, 0.5)));
         // Turned by 90 degrees, what the map shows along +x is seen along -z... (cos 90, 0, -sin 90).
         let turned = EnvironmentLight::new(&map_env(4, 2, |x, y| Vec3::new(x as f32, y as f32, 1.0), 90.0));
         for d in [Vec3::new(1.0, 0.3, 0.02), Vec3::new(0.2, -0.5, 1.0), Vec3::new(-0.7, 0.1, 0.3)] {
             let seen_along = Vec3::new(d.z, d.y, -d.x); // d turned by 90 degrees, +x to -z
-            assert_eq!(turned.radiance(seen_along), light.radiance(d), "{d}");
+            assert!(close(turned.radiance(seen_along), light.radiance(d)), "{d}");
         }
         let sky = Environment {
             sky: Sky::Gradient { zenith: Vec3::new(0.0, 0.0, 2.0), horizon: Vec3::ONE, ground: Vec3::ZERO },
@@ -317,10 +360,39 @@ mod tests {
             if (uv - uv.round()).abs().min_element() > 1e-3 {
                 let pdf = light.pdf(s.direction);
                 assert!((s.pdf - pdf).abs() <= 1e-4 * pdf, "{} against {pdf}", s.pdf);
-                assert_eq!(s.radiance, light.radiance(s.direction));
+                let radiance = light.radiance(s.direction);
+                assert!((s.radiance - radiance).abs().max_element() <= 1e-4 * radiance.max_element(), "{radiance}");
             }
         }
         let black = EnvironmentLight::new(&map_env(4, 2, |_, _| Vec3::ZERO, 0.0));
         assert!(black.is_black() && black.sample(Vec2::new(0.5, 0.5)).is_none() && black.pdf(Vec3::X) == 0.0);
+    }
+
+    #[test]
+    fn every_lit_direction_has_a_density() {
+        // One lit pixel in the dark, at the left edge so that its light wraps to the right edge,
+        // and one on the top row: the bilinear lookup spreads each over half of its neighbours,
+        // and the sampling table covers all of that.
+        let env =
+            map_env(16, 8, |x, y| if (x, y) == (0, 4) || (x, y) == (9, 0) { Vec3::ONE } else { Vec3::ZERO }, 20.0);
+        let light = EnvironmentLight::new(&env);
+        let (mut lit, mut dark) = (0, 0);
+        for i in 0..400 {
+            for j in 0..800 {
+                let uv = Vec2::new((j as f32 + 0.5) / 800.0, (i as f32 + 0.5) / 400.0);
+                let d = light.direction(uv);
+                if light.radiance(d).max_element() > 0.0 {
+                    lit += 1;
+                    assert!(light.pdf(d) > 0.0, "lit at {uv} with no density");
+                } else {
+                    dark += 1;
+                }
+            }
+        }
+        // The lit share: two pixels' tents, 2 x 2 pixels each of 128, less the top row's clamp.
+        assert!(lit > 0 && dark > 0 && (lit as f64 / (lit + dark) as f64) < 8.0 / 128.0, "{lit} {dark}");
+        // The table is the bilinear reconstruction's mean over each pixel: [1 6 1] / 8 per axis.
+        let means = pixel_means(&[0.0, 8.0, 0.0, 0.0, 0.0, 0.0], 3, 2);
+        assert_eq!(means, vec![7.0 / 8.0, 42.0 / 8.0, 7.0 / 8.0, 1.0 / 8.0, 6.0 / 8.0, 1.0 / 8.0]);
     }
 }

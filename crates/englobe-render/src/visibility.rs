@@ -8,17 +8,23 @@
 //! transparency, Enderton, Sintorn, Shirley and Luebke 2010), decided by a hash of the hit (object,
 //! triangle, and the bits of its barycentric coordinates), so that a closest-hit query and a shadow
 //! ray that meet the same point of the same surface decide alike, and a render stays the same bytes
-//! on any number of threads. Scenes without such materials run the unfiltered queries, at no cost.
+//! on any number of threads.
+//!
+//! The same filter culls back faces: a triangle of a single-sided material (glTF `doubleSided:
+//! false`, see [`englobe_scene::Material::culls_back_faces`]) is not there for a ray that meets it
+//! from behind (the side against its winding's normal), as a rasteriser's back-face culling
+//! hides it. Scenes with neither cut-outs nor single-sided triangles run the unfiltered queries,
+//! at no cost.
 
-use englobe::{Counters, Ray, World, WorldHit};
+use englobe::{Counters, Object, Ray, Shape, World, WorldHit};
 use englobe_scene::Scene;
 
 /// The world's queries with the scene's cut-outs applied.
 pub struct Visibility<'a> {
     scene: &'a Scene,
     world: &'a World,
-    /// Whether some material has a coverage to test.
-    cutouts: bool,
+    /// Whether some material has a coverage to test or back faces to cull.
+    filtered: bool,
 }
 
 /// A number in `[0, 1)` from the hit alone (SplitMix64's finaliser over its identifiers).
@@ -34,7 +40,8 @@ fn hit_number(h: &WorldHit) -> f32 {
 impl<'a> Visibility<'a> {
     /// The queries of `world`, built over the objects of `scene` in order.
     pub fn new(scene: &'a Scene, world: &'a World) -> Self {
-        Visibility { scene, world, cutouts: scene.materials.iter().any(|m| m.has_cutouts()) }
+        let filtered = scene.materials.iter().any(|m| m.has_cutouts() || m.culls_back_faces());
+        Visibility { scene, world, filtered }
     }
 
     /// The world.
@@ -42,18 +49,33 @@ impl<'a> Visibility<'a> {
         self.world
     }
 
-    /// Whether `hit` is on a surface that is there (not cut out, or covered at this point).
-    fn solid(&self, hit: &WorldHit) -> bool {
+    /// Whether `hit` of `ray` is on a surface that is there: not a culled back face, and not cut
+    /// out (or covered at this point).
+    fn solid(&self, ray: &Ray, hit: &WorldHit) -> bool {
         let object = &self.scene.objects[hit.object as usize];
         let m = &self.scene.materials[object.material_of(hit.prim) as usize];
+        if m.culls_back_faces() && self.is_back_face(ray, hit) {
+            return false;
+        }
         !m.has_cutouts() || !m.passes_through(&self.scene.textures, object.uv(hit.prim, hit.u, hit.v), hit_number(hit))
+    }
+
+    /// True when `ray` meets the triangle of `hit` from behind. Other shapes have no back face
+    /// to cull: their inside is not a side a viewer could be shown.
+    fn is_back_face(&self, ray: &Ray, hit: &WorldHit) -> bool {
+        let object = &self.world.objects()[hit.object as usize];
+        if !matches!(object, Object::Shape(Shape::Triangle(_)) | Object::Mesh(_) | Object::Instance(_)) {
+            return false;
+        }
+        let p = self.world.hit_point(ray, hit);
+        ray.dir().dot(self.world.geometric_normal(hit, p)) > 0.0
     }
 
     /// The closest hit on a surface that is there.
     #[inline]
     pub fn closest_hit<C: Counters>(&self, ray: &Ray, counters: &mut C) -> Option<WorldHit> {
-        if self.cutouts {
-            self.world.closest_hit_filtered(ray, counters, |h: &WorldHit| self.solid(h))
+        if self.filtered {
+            self.world.closest_hit_filtered(ray, counters, |h: &WorldHit| self.solid(ray, h))
         } else {
             self.world.closest_hit(ray, counters)
         }
@@ -62,8 +84,8 @@ impl<'a> Visibility<'a> {
     /// Whether a surface that is there lies within the ray's interval.
     #[inline]
     pub fn any_hit<C: Counters>(&self, ray: &Ray, counters: &mut C) -> bool {
-        if self.cutouts {
-            self.world.any_hit_filtered(ray, counters, |h: &WorldHit| self.solid(h))
+        if self.filtered {
+            self.world.any_hit_filtered(ray, counters, |h: &WorldHit| self.solid(ray, h))
         } else {
             self.world.any_hit(ray, counters)
         }

@@ -296,8 +296,8 @@ material = "m"
 }
 
 /// `rho / π` times the irradiance that `light` gives a surface of unit normal `n`, by the
-/// midpoint rule on the map's pixels (the radiance is constant on each; the cosine is not, so
-/// each pixel is cut in `sub` x `sub`).
+/// midpoint rule on the map's pixels, each cut in `sub` x `sub` (neither the bilinear radiance
+/// nor the cosine is constant over a pixel).
 fn reflected_exactly(light: &EnvironmentLight, width: usize, height: usize, rho: f64, n: Vec3) -> f64 {
     let sub = 8;
     let (dt, dp) = (PI / (height * sub) as f64, 2.0 * PI / (width * sub) as f64);
@@ -392,24 +392,36 @@ fn write_map(map: &EnvironmentMap, path: &std::path::Path) {
 #[test]
 fn both_integrators_see_the_map_where_the_layout_says() {
     // A 4 x 2 map of distinct colours, read from a file; a one-pixel camera at the origin looking
-    // along +x (slightly up) sees column 2 of the top row, along +z (slightly down) column 3 of
-    // the bottom row; turned by 90 degrees, what the map has along +x is seen along
-    // (cos 90, 0, -sin 90) = -z.
+    // at the centre of pixel (2, 0) (u = 5/8, v = 1/4: azimuth 45 degrees from +x towards +z, 45
+    // degrees below straight up) sees it alone, at the centre of pixel (3, 1) (u = 7/8, v = 3/4)
+    // that one; halfway between the centres of (2, 0) and (3, 0) (u = 3/4, along +z) their mean,
+    // the lookup being bilinear; turned by 90 degrees, what the map has along (x, y, z) is seen
+    // along (z, y, -x).
     let dir = tempfile::tempdir().unwrap();
     let pixels = (0..8).map(|i| Vec3::new(i as f32, 10.0 + i as f32, 0.5)).collect();
     let map = EnvironmentMap { path: "four.exr".into(), width: 4, height: 2, pixels };
     let path = dir.path().join("four.exr");
     write_map(&map, &path);
+    let h = std::f32::consts::FRAC_1_SQRT_2;
+    let between = (map.get(2, 0) + map.get(3, 0)) * 0.5;
     for integrator in ["whitted", "path"] {
-        for (look_at, rotation, (x, y)) in
-            [([1.0, 0.2, 0.02], 0.0, (2, 0)), ([-0.02, -0.2, 1.0], 0.0, (3, 1)), ([0.02, 0.2, -1.0], 90.0, (2, 0))]
-        {
+        for (look_at, rotation, want) in [
+            ([0.5, h, 0.5], 0.0, map.get(2, 0)),
+            ([-0.5, -h, 0.5], 0.0, map.get(3, 1)),
+            ([0.0, h, h], 0.0, between),
+            ([0.5, h, -0.5], 90.0, map.get(2, 0)),
+        ] {
             let s = scene(&format!(
                 "[image]\nwidth = 1\nheight = 1\nintegrator = \"{integrator}\"\n[camera]\nposition = [0, 0, 0]\n\
                  look_at = {look_at:?}\nfov = 1\n[environment]\nfile = \"{}\"\nrotation = {rotation}\nintensity = 2\n",
                 path.display()
             ));
-            assert_eq!(render(&s)[0], map.get(x, y) * 2.0, "{integrator}, looking at {look_at:?}, turned {rotation}");
+            let seen = render(&s)[0];
+            assert!(
+                (seen - want * 2.0).abs().max_element() < 1e-3,
+                "{integrator}, looking at {look_at:?}, turned {rotation}: {seen} against {}",
+                want * 2.0
+            );
         }
     }
 }

@@ -1,7 +1,8 @@
 //! Materials in the integrators: a cut-out texel is passed through by closest-hit and shadow
 //! queries alike, in every structure, and partly covered surfaces are passed through by both
-//! kinds of query at the same points; metallic-roughness surfaces vanish in a white furnace where
-//! their BSDF conserves energy.
+//! kinds of query at the same points; the back faces of single-sided materials are culled by both
+//! queries; metallic-roughness surfaces vanish in a white furnace where their BSDF conserves
+//! energy.
 
 use std::sync::Arc;
 
@@ -9,7 +10,9 @@ use englobe::{AccelKind, NoCount, Object, Ray, TriangleMesh, Vec2, Vec3};
 use englobe_render::visibility::Visibility;
 use englobe_render::{Renderer, build_world};
 use englobe_scene::texture::{Sampler, TexelImage, Texture, TextureSource};
-use englobe_scene::{Alpha, AlphaMode, Material, MaterialTextures, Scene, SceneObject, TextureRef, parse_scene};
+use englobe_scene::{
+    Alpha, AlphaMode, Material, MaterialModel, MaterialTextures, Scene, SceneObject, TextureRef, parse_scene,
+};
 
 const BEHIND: &str = "
 [image]
@@ -98,6 +101,37 @@ fn partly_covered_surfaces_are_passed_where_both_queries_agree() {
     // Coverage 128/255: about half the rays pass (1600 rays, a binomial's sd is 20).
     let share = passed as f64 / (n * n) as f64;
     assert!((share - (1.0 - 128.0 / 255.0)).abs() < 0.05, "{share}");
+}
+
+#[test]
+fn single_sided_triangles_are_culled_from_behind_by_both_queries_in_every_structure() {
+    // The quad's winding faces +z, toward the camera at z = 5. A second quad at z = -6, facing
+    // +z too, stands behind the sphere.
+    let with = |double_sided: bool, transmission: f32| {
+        let mut scene = quad_scene([255, 255], AlphaMode::Opaque);
+        let m = scene.materials.last_mut().unwrap();
+        m.double_sided = double_sided;
+        m.model = MaterialModel::MetallicRoughness { metallic: 0.0, roughness: 0.5, transmission };
+        scene
+    };
+    let front = Ray::new(Vec3::new(0.2, 0.1, 5.0), -Vec3::Z);
+    let back = Ray::new(Vec3::new(0.2, 0.1, -0.5), Vec3::Z);
+    for &kind in AccelKind::ALL {
+        for (double_sided, transmission, culled) in [(false, 0.0, true), (true, 0.0, false), (false, 1.0, false)] {
+            let scene = with(double_sided, transmission);
+            let quad = scene.objects.len() as u32 - 1;
+            let world = build_world(&scene, kind).unwrap();
+            let vis = Visibility::new(&scene, &world);
+            let what = format!("{kind}, double_sided {double_sided}, transmission {transmission}");
+            let hit = vis.closest_hit(&front, &mut NoCount).expect("the quad's front");
+            assert_eq!((hit.object, hit.t), (quad, 5.0), "{what}: the front face is always there");
+            assert!(vis.any_hit(&Ray::segment(front.origin(), front.dir(), 0.0, 5.5), &mut NoCount), "{what}");
+            let hit = vis.closest_hit(&back, &mut NoCount);
+            assert_eq!(hit.is_none(), culled, "{what}: from behind, {hit:?}");
+            assert_eq!(!vis.any_hit(&back, &mut NoCount), culled, "{what}: a shadow ray from behind");
+            assert!(world.closest_hit(&back, &mut NoCount).is_some(), "{what}: the unfiltered query sees it");
+        }
+    }
 }
 
 /// The mean of the film's pixels of a furnace: one sphere of `material` under a white sky.

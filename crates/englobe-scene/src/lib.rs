@@ -9,6 +9,7 @@ pub mod environment;
 pub mod error;
 pub mod format;
 pub mod framing;
+pub mod load_observer;
 pub mod material;
 pub mod material_eval;
 pub mod mesh;
@@ -27,6 +28,7 @@ pub mod texture;
 
 pub use environment::{Environment, EnvironmentMap, Sky};
 pub use error::{Located, SceneError};
+pub use load_observer::{LoadObserver, Unobserved};
 pub use material::{
     Alpha, AlphaMode, Channel, MaterialModel, MaterialTextures, NormalEncoding, NormalMap, ScalarTexture, TextureRef,
     UvTransform,
@@ -37,7 +39,10 @@ pub use model::{
     OutputSettings, Projection, SamplerKind, Scene, SceneObject, TextureFilter, ToneMap,
 };
 pub use overrides::Override;
-pub use parse::{DEFAULT_MATERIAL, load_scene, load_scene_with, parse_scene, parse_scene_with};
+pub use parse::{
+    DEFAULT_MATERIAL, load_scene, load_scene_observed, load_scene_with, parse_scene, parse_scene_observed,
+    parse_scene_with,
+};
 pub use parse_mesh::MAX_MESH_INSTANCES;
 pub use pixel_filter::PixelFilter;
 pub use random_triangles::MAX_RANDOM_TRIANGLES;

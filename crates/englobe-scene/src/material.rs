@@ -344,6 +344,16 @@ impl Material {
     pub fn has_cutouts(&self) -> bool {
         self.alpha.mode != AlphaMode::Opaque
     }
+
+    /// True when rays ignore the back faces of the material's triangles (the side against their
+    /// winding's normal): single-sided materials (glTF `doubleSided: false`) that transmit no
+    /// light. A transmitting one keeps its back faces, since light leaves its inside through
+    /// them.
+    pub fn culls_back_faces(&self) -> bool {
+        let transmits =
+            matches!(self.model, MaterialModel::MetallicRoughness { transmission, .. } if transmission > 0.0);
+        !self.double_sided && !transmits && self.transparency <= 0.0
+    }
 }
 
 /// Perceptual roughness (`sqrt(alpha)`) equivalent to a Blinn-Phong exponent: the

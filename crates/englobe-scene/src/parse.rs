@@ -12,6 +12,7 @@ use toml::de::DeTable;
 
 use crate::error::{Located, SceneError};
 use crate::format::{CameraDef, FilterRadius, ImageDef, ProjectionKind, SceneFile};
+use crate::load_observer::{LoadObserver, Unobserved};
 use crate::model::{Camera, ImageSettings, Light, MaterialId, Projection, Scene, SceneObject};
 use crate::overrides::{Override, Placed};
 use crate::pixel_filter::{MAX_FILTER_RADIUS, PixelFilter};
@@ -33,6 +34,16 @@ pub fn load_scene(path: &Path) -> Result<Scene, SceneError> {
 /// A `.pbrt` file is read by [`crate::pbrt::load`] (not strict); overrides do not apply to it, so
 /// any is refused.
 pub fn load_scene_with(path: &Path, overrides: &[Override]) -> Result<Scene, SceneError> {
+    load_scene_observed(path, overrides, &Unobserved)
+}
+
+/// [`load_scene_with`], telling `observer` when each mesh file starts and ends loading (not for
+/// `.pbrt` files, whose shapes are not mesh files).
+pub fn load_scene_observed(
+    path: &Path,
+    overrides: &[Override],
+    observer: &dyn LoadObserver,
+) -> Result<Scene, SceneError> {
     if crate::pbrt::is_pbrt_path(path) {
         crate::pbrt::refuse_overrides(overrides)?;
         return crate::pbrt::load(path, false);
@@ -58,7 +69,7 @@ pub fn load_scene_with(path: &Path, overrides: &[Override]) -> Result<Scene, Sce
         let at = e.utf8_error().valid_up_to();
         SceneError::at(&path.display().to_string(), "", None, format!("byte {at}: the file is not valid UTF-8"))
     })?;
-    parse_scene_with(&text, path, overrides)
+    parse_scene_observed(&text, path, overrides, observer)
 }
 
 /// Validates scene `text`; `file` names it in errors.
@@ -69,6 +80,16 @@ pub fn parse_scene(text: &str, file: &Path) -> Result<Scene, SceneError> {
 /// Applies `overrides` to scene `text` and validates the result; `file` names the text in errors,
 /// and an error in an overridden value names the override.
 pub fn parse_scene_with(text: &str, file: &Path, overrides: &[Override]) -> Result<Scene, SceneError> {
+    parse_scene_observed(text, file, overrides, &Unobserved)
+}
+
+/// [`parse_scene_with`], telling `observer` when each mesh file starts and ends loading.
+pub fn parse_scene_observed(
+    text: &str,
+    file: &Path,
+    overrides: &[Override],
+    observer: &dyn LoadObserver,
+) -> Result<Scene, SceneError> {
     let name = file.display().to_string();
     let placed = Placed::new(text.len(), overrides);
     let invalid = |span: Option<Range<usize>>, message: &str| {
@@ -77,7 +98,7 @@ pub fn parse_scene_with(text: &str, file: &Path, overrides: &[Override]) -> Resu
     let mut root = DeTable::parse(text).map_err(|e| invalid(e.span(), e.message()))?;
     crate::overrides::apply(root.get_mut(), overrides, &placed, &name, text).map_err(SceneError::Invalid)?;
     let def = SceneFile::deserialize(toml::de::Deserializer::from(root)).map_err(|e| invalid(e.span(), e.message()))?;
-    Converter { file: &name, text, dir: file.parent().unwrap_or(Path::new("")), placed: &placed }.scene(def)
+    Converter { file: &name, text, dir: file.parent().unwrap_or(Path::new("")), placed: &placed, observer }.scene(def)
 }
 
 pub(crate) struct Converter<'a> {
@@ -87,6 +108,8 @@ pub(crate) struct Converter<'a> {
     pub(crate) dir: &'a Path,
     /// Where the command line's overrides stand, for errors in their values.
     pub(crate) placed: &'a Placed,
+    /// Told of each mesh file as it loads.
+    pub(crate) observer: &'a dyn LoadObserver,
 }
 
 impl Converter<'_> {

@@ -82,6 +82,8 @@ impl Converter<'_> {
                 want_tangents,
             );
             if !cache.contains_key(&key) {
+                self.observer.mesh_started(&file);
+                let start = std::time::Instant::now();
                 let loaded = load_mesh_file_with(&file, &options).map_err(|mesh| SceneError::Mesh {
                     located: located(
                         self,
@@ -90,6 +92,7 @@ impl Converter<'_> {
                     ),
                     mesh: Box::new(mesh),
                 })?;
+                self.observer.mesh_loaded(&file, loaded.mesh.len(), start.elapsed());
                 scene.warnings.extend(loaded.warnings.iter().map(|w| format!("{}: {w}", file.display())));
                 let stem = file.file_name().map_or(String::new(), |n| n.to_string_lossy().into_owned());
                 let first = scene.materials.len() as MaterialId;

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use englobe::{Vec2, Vec3};
 use englobe_scene::mesh::load_mesh_file;
 use englobe_scene::shared_data::shared_meshes_or_panic;
-use englobe_scene::{AlphaMode, Channel, MISSING_TEXTURE_COLOR, NormalEncoding};
+use englobe_scene::{AlphaMode, Channel, MISSING_TEXTURE_COLOR, MaterialModel, NormalEncoding};
 
 fn write(dir: &Path, name: &str, bytes: &[u8]) -> PathBuf {
     let p = dir.join(name);
@@ -56,10 +56,12 @@ fn maps_resolve_beside_the_library_and_coordinates_flip() {
     assert_eq!((mat.alpha.mode, mat.alpha.factor), (AlphaMode::Mask { cutoff: 0.5 }, 0.9));
     assert_eq!(mat.textures.alpha.unwrap().channel, Channel::Alpha, "the image has alpha");
     assert!(mat.is_cut_out(&m.textures, at(0.1, 0.5)) && !mat.is_cut_out(&m.textures, at(0.9, 0.5)));
-    // The missing map_Ks is a warning naming the material and the file; the highlight is unchanged.
+    // The missing map_Ks is a warning naming the material and the file; the texture is kept as
+    // unreadable, which leaves the material's factors alone.
     let w = m.warnings.join("\n");
     assert!(w.contains("`m`") && w.contains("missing.png"), "{w}");
-    assert_eq!(mat.evaluate(&m.textures, at(0.5, 0.5)).specular, mat.specular);
+    let specular = mat.textures.specular.unwrap().texture as usize;
+    assert!(m.textures[specular].image.is_none());
 }
 
 #[test]
@@ -100,9 +102,16 @@ fn the_cornell_box_boxes_are_white() {
         let mat = &m.materials.iter().find(|(n, _)| n == name).unwrap().1;
         // The file gives the boxes Kd 0 0 0 and their white as Ka (and Ks).
         assert_eq!(mat.diffuse, Vec3::new(0.725, 0.71, 0.68), "{name}");
+        // Ks white, Ns 200, Ni 1.44: a white plastic, its layer rough by alpha = sqrt(2 / 202).
+        let roughness = (2.0f32 / 202.0).sqrt().sqrt();
+        assert_eq!(mat.model, MaterialModel::MetallicRoughness { metallic: 0.0, roughness, transmission: 0.0 });
+        assert_eq!(mat.ior, 1.44, "{name}");
     }
     let walls = &m.materials.iter().find(|(n, _)| n == "leftWall").unwrap().1;
     assert_eq!(walls.diffuse, Vec3::new(0.63, 0.065, 0.05));
+    // Ks 0: Lambert, no specular layer (index 1).
+    assert_eq!(walls.ior, 1.0);
+    assert!(matches!(walls.model, MaterialModel::MetallicRoughness { metallic: 0.0, transmission: 0.0, .. }));
     // The walls and box faces meet at about right angles: smoothing at 60 degrees joins only the
     // two slightly bent halves of each quad (the measured box is not square), never two faces,
     // which would tilt normals by about 45 degrees.

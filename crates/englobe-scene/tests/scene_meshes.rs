@@ -1,11 +1,11 @@
-//! `[[mesh]]` entries of scene files: placement, instances, materials, and errors that name both
-//! the scene line and the mesh file.
+//! `[[mesh]]` entries of scene files: placement, instances, materials, errors that name both
+//! the scene line and the mesh file, and the loading of each file told to an observer.
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use englobe::{Object, Vec3};
-use englobe_scene::{Scene, SceneError, load_scene};
+use englobe_scene::{LoadObserver, Scene, SceneError, load_scene, load_scene_observed};
 
 const HEAD: &str = "[image]\nwidth = 8\nheight = 8\n[camera]\nposition = [0, 0, -5]\nlook_at = [0, 0, 0]\n";
 
@@ -166,4 +166,37 @@ fn bad_placements_are_refused_at_their_line() {
         assert_eq!(l, line, "{body}: {shown}");
         assert!(shown.contains(says), "{body}: {shown}");
     }
+}
+
+/// Records what a [`LoadObserver`] is told.
+#[derive(Default)]
+struct Recorder(std::cell::RefCell<Vec<String>>);
+
+impl LoadObserver for Recorder {
+    fn mesh_started(&self, path: &Path) {
+        self.0.borrow_mut().push(format!("start {}", path.file_name().unwrap().to_string_lossy()));
+    }
+    fn mesh_loaded(&self, path: &Path, triangles: usize, elapsed: std::time::Duration) {
+        assert!(elapsed.as_secs() < 60);
+        self.0.borrow_mut().push(format!("loaded {} {triangles}", path.file_name().unwrap().to_string_lossy()));
+    }
+}
+
+#[test]
+fn each_mesh_file_is_told_to_the_observer_once_in_order() {
+    let dir = folder();
+    let file = dir.path().join("scene.toml");
+    let body = "[[mesh]]\npath = \"quad.obj\"\n[[mesh]]\npath = \"tri.obj\"\n[[mesh]]\npath = \"quad.obj\"\n\
+                translate = [2, 0, 0]\n";
+    std::fs::write(&file, format!("{HEAD}{body}")).unwrap();
+    let seen = Recorder::default();
+    let scene = load_scene_observed(&file, &[], &seen).unwrap();
+    assert_eq!(scene.objects.len(), 3);
+    assert_eq!(*seen.0.borrow(), ["start quad.obj", "loaded quad.obj 2", "start tri.obj", "loaded tri.obj 1"]);
+    // A file that fails is started and not loaded.
+    std::fs::write(dir.path().join("bad.obj"), "v 0 0 0\nf 1 2 3\n").unwrap();
+    std::fs::write(&file, format!("{HEAD}[[mesh]]\npath = \"tri.obj\"\n[[mesh]]\npath = \"bad.obj\"\n")).unwrap();
+    let seen = Recorder::default();
+    assert!(load_scene_observed(&file, &[], &seen).is_err());
+    assert_eq!(*seen.0.borrow(), ["start tri.obj", "loaded tri.obj 1", "start bad.obj"]);
 }

@@ -53,8 +53,13 @@ impl Bsdf {
     /// glTF 2.0's metallic-roughness material: linear `base_color`, `metallic`, perceptual
     /// `roughness` (`alpha = roughness²`), `KHR_materials_transmission`'s `transmission` and
     /// `KHR_materials_ior`'s `ior` (1.5 by default in glTF). See
-    /// [`MetallicRoughness`].
+    /// [`MetallicRoughness`]. An opaque dielectric of index 1 is [`Bsdf::lambert`] of its base
+    /// colour: a boundary between equal indices reflects nothing, where Schlick's approximation
+    /// would still reflect at grazing angles (MTL materials without a highlight map to it).
     pub fn metallic_roughness(base_color: Vec3, metallic: f32, roughness: f32, transmission: f32, ior: f32) -> Bsdf {
+        if ior == 1.0 && metallic <= 0.0 && transmission <= 0.0 {
+            return Bsdf::lambert(base_color);
+        }
         Bsdf::MetallicRoughness(MetallicRoughness::new(base_color, metallic, roughness, transmission, ior))
     }
 

@@ -122,3 +122,20 @@ fn bsdf_gltf_smooth_metal_is_a_mirror_of_its_base_colour() {
     assert!(near as f64 > 0.99 * n as f64, "{near} of {n} within 5 degrees of the mirror direction");
     assert!((sum / n as f32 - base).abs().max_element() < 2e-3, "{}", sum / n as f32);
 }
+
+/// An opaque glTF dielectric of index 1 has no specular layer: Lambert's `base / π` at every
+/// angle, grazing ones included, where Schlick's approximation of a layer would add
+/// `(1 - cos θ)⁵`; a layer of 1.5 reflects more than that at 85 degrees.
+#[test]
+fn bsdf_gltf_dielectric_of_index_one_is_lambert() {
+    let base = Vec3::new(0.6, 0.3, 0.1);
+    let plain = Bsdf::metallic_roughness(base, 0.0, 0.4, 0.0, 1.0);
+    assert_eq!(plain, Bsdf::lambert(base));
+    let lambert = base / std::f32::consts::PI;
+    let (wo, wi) = (dir(85.0, 0.0), dir(85.0, 180.0));
+    assert!((plain.eval(wo, wi) - lambert).abs().max_element() < 1e-6);
+    let coated = Bsdf::metallic_roughness(base, 0.0, 0.4, 0.0, 1.5);
+    assert!(coated.eval(wo, wi).z > 2.0 * lambert.z, "{}", coated.eval(wo, wi));
+    // A metal or a transmitting dielectric of index 1 keeps the glTF model.
+    assert_ne!(Bsdf::metallic_roughness(base, 0.5, 0.4, 0.0, 1.0), Bsdf::lambert(base));
+}

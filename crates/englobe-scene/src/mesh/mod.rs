@@ -11,6 +11,7 @@ mod gltf_data;
 mod gltf_material;
 mod loaded;
 mod mtl;
+mod mtl_color;
 mod mtl_map;
 mod mtl_material;
 mod obj;
@@ -69,10 +70,13 @@ fn read_mesh_file(path: &Path) -> Result<LoadedMesh, MeshFileError> {
 }
 
 /// Checks the text of an MTL material library as OBJ loading does (every statement, texture
-/// statements and their options included), without reading the textures; `path` names it in
-/// errors.
+/// statements and their options included, then `tobj`'s parse of the text as englobe rewrites
+/// it), without reading the textures; `path` names it in errors.
 pub fn check_mtl_text(path: &Path, text: &str) -> Result<(), MeshFileError> {
-    mtl::scan(path, text).map(|_| ())
+    let scan = mtl::scan(path, text)?;
+    read::guarded(path, "MTL", || tobj::load_mtl_buf(&mut scan.text.as_bytes()))?
+        .map(|_| ())
+        .map_err(|e| MeshFileError::file(path, MeshErrorKind::Parser(format!("tobj: {e}"))))
 }
 
 /// Reads and checks a mesh already in memory, as it is in the file (no normals or tangents

@@ -1,28 +1,35 @@
 //! The mapping of MTL materials onto englobe's (documented in `docs/scene-format.md`, "MTL
-//! materials"). MTL describes the Phong-style shading of Wavefront's Advanced Visualizer, so its
-//! materials stay in the classic model, which reads the same numbers the same way:
+//! materials"). MTL describes the Phong-style shading of Wavefront's Advanced Visualizer; englobe
+//! maps it onto the microfacet materials glTF files get (the metallic-roughness model over the
+//! Trowbridge-Reitz distribution, see `englobe_render::bsdf`), so that an OBJ renders with the
+//! same physically based scattering as a glTF:
 //!
 //! | MTL | englobe |
 //! |---|---|
-//! | `Kd`, `map_Kd` | `diffuse` and the base colour texture (sRGB) |
+//! | `Kd`, `map_Kd` | base colour and its texture (sRGB) |
 //! | `Ka` | the diffuse colour when `Kd` is black, `Ka` is not and there is no `map_Kd` (a warning says so) |
-//! | `Ks`, `map_Ks` | `specular` and its texture (none under `illum` 0 and 1, which have no highlight) |
-//! | `Ns` | `shininess` |
-//! | `Ni` | `ior` (values not above 0 keep the default) |
-//! | `Ke`, `map_Ke` | `emission` and its texture (`map_Ke` without `Ke` glows at 1) |
-//! | `illum` 3, 5, 6, 7 (ray-traced reflection) | `reflectivity` = largest component of `Ks`, at most `1 - transparency` |
-//! | `illum` 4, 6, 7, 9 (glass) | `transparency = 1 - d` (`Tr` = 1 - `d` when `d` is absent) |
+//! | `Ns` | roughness: the GGX width with the Phong lobe's peak, `alpha = sqrt(2 / (Ns + 2))` (Walter, Marschner, Li and Torrance 2007, section 5.2); perceptual roughness `sqrt(alpha)`; 32 when absent |
+//! | `Ks` black, or `illum` 0 and 1 | Lambert (no specular layer: index 1) |
+//! | `Ks` and `Kd` not black, `illum` 2 | plastic: Lambert `Kd` under a dielectric layer of index `Ni` (1.5 when not above 1), rough by `Ns` |
+//! | `Kd` black, `Ks` not, `illum` 2 | a rough conductor of reflectance `Ks` (metallic 1, base colour `Ks`, `map_Ks` its texture) |
+//! | `illum` 3, 5 (and 6, 7 with `d` 1): mirrors | smooth; `Kd` diffuse and a mirror of `Ks`: metallic `max Ks / (max Kd + max Ks)`, base colour `min(Kd + Ks, 1)` (exact when `Kd` and `Ks` are grey, proportional, or one is black) |
+//! | `illum` 4, 6, 7, 9 with `d` < 1: glass | smooth dielectric of index `Ni` (1.5 when not above 0), transmission `1 - d` (`Tr` = 1 - `d` when `d` is absent), tinted by `Tf` (white when absent) |
 //! | other `illum`, `d` < 1 | coverage: `alpha_mode` blend, alpha `d` (dissolve) |
+//! | `Ke`, `map_Ke` | `emission` and its texture (`map_Ke` without `Ke` glows at 1) |
 //! | `map_d` | coverage texture, cut out below 0.5 (`alpha_mode` mask), times `d` |
 //! | `norm` | tangent-space normal map, `-bm` its scale |
 //! | `bump`, `map_Bump` | height map (`-imfchan`, luminance by default; `-bm` its scale), or a normal map when the image is one (blue around 1, red and green around 0.5 on average) |
-//! | `Pr`, `Pm` (the PBR extension) | the metallic-roughness model, roughness `Pr` (default from `Ns`), metalness `Pm` (default 0) |
+//! | `Pr`, `Pm` (the PBR extension) | roughness `Pr` (default from `Ns`), metalness `Pm` (default 0), base colour `Kd`, index `Ni` |
+//!
+//! The classic fields (`specular`, `shininess`, `reflectivity`, `transparency`) keep the MTL's
+//! numbers for the Whitted integrator, which reads mirrors and glass from them; `diffuse` is the
+//! base colour.
 //!
 //! Texture options: `-o` and `-s` become the texture transform (applied in OBJ's coordinates, `v`
 //! up), `-clamp on` clamps to the edge, `-imfchan` picks the channel of `map_d` and bump maps and
 //! `-mm` remaps their values; `-blendu`, `-blendv`, `-boost`, `-cc`, `-t`, `-texres` and `-type`
 //! are read and have no effect. `map_Ka`, `map_Ns`, `disp`, `decal` and `refl` are read and not
-//! used. Paths are relative to the MTL file (`\` read as `/` when the name is not found as is).
+//! used. Paths are relative to the MTL file (`\\` read as `/` when the name is not found as is).
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -131,6 +138,66 @@ impl MtlTextures {
     }
 }
 
+/// The MTL numbers the microfacet mapping reads.
+struct MtlLobes {
+    /// `Kd` (or `Ka` in its place).
+    diffuse: Vec3,
+    /// `Ks`, black under `illum` 0 and 1.
+    specular: Vec3,
+    /// `Ns`.
+    shininess: f32,
+    illum: Option<u8>,
+    /// `1 - d` for glass, else 0.
+    transmission: f32,
+    /// `Ni`, when above 0.
+    ni: Option<f32>,
+    /// `Tf`.
+    tint: Option<Vec3>,
+}
+
+/// The metallic-roughness parameters of an MTL material (the module's table).
+#[derive(Debug, PartialEq)]
+struct Layers {
+    base_color: Vec3,
+    metallic: f32,
+    roughness: f32,
+    ior: f32,
+    /// True for a conductor whose colour is `Ks`: `map_Ks` is then its base colour texture.
+    metal_from_specular: bool,
+}
+
+fn layers(l: &MtlLobes) -> Layers {
+    let (kd, ks) = (l.diffuse.max_element(), l.specular.max_element());
+    let glossy = shininess_to_roughness(l.shininess);
+    // Index 1: no dielectric layer, so a surface without a highlight is Lambertian.
+    let lambert =
+        Layers { base_color: l.diffuse, metallic: 0.0, roughness: glossy, ior: 1.0, metal_from_specular: false };
+    if l.transmission > 0.0 {
+        let base_color = l.tint.unwrap_or(Vec3::ONE);
+        return Layers {
+            base_color,
+            metallic: 0.0,
+            roughness: 0.0,
+            ior: l.ni.unwrap_or(1.5),
+            metal_from_specular: false,
+        };
+    }
+    if ks <= 0.0 {
+        return lambert;
+    }
+    if matches!(l.illum, Some(3 | 5 | 6 | 7)) {
+        // A mirror of reflectance Ks beside a diffuse Kd: the metal's share and the diffuse
+        // share of one base colour reflect Ks and Kd (scaled down together where they sum
+        // above 1).
+        let base_color = (l.diffuse + l.specular).min(Vec3::ONE);
+        return Layers { base_color, metallic: ks / (kd + ks), roughness: 0.0, ..lambert };
+    }
+    if kd <= 0.0 {
+        return Layers { base_color: l.specular, metallic: 1.0, metal_from_specular: true, ..lambert };
+    }
+    Layers { ior: l.ni.filter(|n| *n > 1.0).unwrap_or(1.5), ..lambert }
+}
+
 /// englobe's material for the checked MTL material `m`, whose texture statements are `maps`
 /// (from the library in folder `dir`).
 pub(super) fn to_material(
@@ -178,31 +245,49 @@ pub(super) fn to_material(
         emission = Vec3::ONE;
     }
     let shininess = m.shininess.filter(|s| *s >= 0.0).unwrap_or(base.shininess);
+    let (pr, pm) = (param("Pr"), param("Pm"));
+    let ni = m.optical_density.filter(|n| *n > 0.0);
+    let layers = if pr.is_some() || pm.is_some() {
+        Layers {
+            base_color: diffuse,
+            metallic: pm.unwrap_or(0.0).clamp(0.0, 1.0),
+            roughness: pr.unwrap_or_else(|| shininess_to_roughness(shininess)).clamp(0.0, 1.0),
+            ior: ni.unwrap_or(base.ior),
+            metal_from_specular: false,
+        }
+    } else {
+        let tint = m.unknown_param.get("Tf").and_then(|t| {
+            let v: Vec<f32> = t.split_whitespace().map_while(|w| w.parse().ok()).collect();
+            (v.len() == 3).then(|| Vec3::new(v[0], v[1], v[2]).clamp(Vec3::ZERO, Vec3::ONE))
+        });
+        layers(&MtlLobes { diffuse, specular, shininess, illum, transmission: transparency, ni, tint })
+    };
     let mut material = Material {
-        diffuse,
+        diffuse: layers.base_color,
         specular,
         shininess,
         reflectivity,
         transparency,
-        ior: m.optical_density.filter(|n| *n > 0.0).unwrap_or(base.ior),
+        ior: layers.ior,
         emission,
+        model: MaterialModel::MetallicRoughness {
+            metallic: layers.metallic,
+            roughness: layers.roughness,
+            transmission: transparency,
+        },
         alpha: Alpha {
             mode: if !glass && dissolve < 1.0 { AlphaMode::Blend } else { AlphaMode::Opaque },
             factor: if glass { 1.0 } else { dissolve },
         },
         ..base
     };
-    let (pr, pm) = (param("Pr"), param("Pm"));
-    if pr.is_some() || pm.is_some() {
-        material.model = MaterialModel::MetallicRoughness {
-            metallic: pm.unwrap_or(0.0).clamp(0.0, 1.0),
-            roughness: pr.unwrap_or_else(|| shininess_to_roughness(shininess)).clamp(0.0, 1.0),
-            transmission: transparency,
-        };
-    }
+    let specular_map = map(&["map_Ks"]);
     let t = &mut material.textures;
-    t.base_color = diffuse_map.map(|s| tex.texture(dir, name, "base colour", s));
-    t.specular = map(&["map_Ks"]).map(|s| tex.texture(dir, name, "specular", s));
+    t.base_color = match (layers.metal_from_specular, specular_map) {
+        (true, Some(s)) => Some(tex.texture(dir, name, "specular", s)),
+        _ => diffuse_map.map(|s| tex.texture(dir, name, "base colour", s)),
+    };
+    t.specular = specular_map.map(|s| tex.texture(dir, name, "specular", s));
     t.emission = emission_map.map(|s| tex.texture(dir, name, "emission", s));
     if let Some(s) = map(&["map_d"]) {
         let texture = tex.texture(dir, name, "alpha", s);
@@ -244,9 +329,10 @@ mod tests {
     use crate::mesh::mtl::scan;
 
     fn one(text: &str) -> (Material, MtlTextures) {
-        let maps = scan(Path::new("t.mtl"), text).unwrap();
-        let (mats, _) = tobj::load_mtl_buf(&mut text.as_bytes()).unwrap();
+        let scanned = scan(Path::new("t.mtl"), text).unwrap();
+        let (mats, _) = tobj::load_mtl_buf(&mut scanned.text.as_bytes()).unwrap();
         let mut tex = MtlTextures::default();
+        let maps = &scanned.maps;
         let m = to_material(&mats[0], maps.get(&mats[0].name).map_or(&[][..], Vec::as_slice), Path::new("."), &mut tex);
         (m, tex)
     }
@@ -254,7 +340,8 @@ mod tests {
     #[test]
     fn mapping_follows_the_table() {
         let (m, _) = one("newmtl glass\nKd 0.1 0.2 0.3\nKs 0.9 0.8 0.7\nNs 50\nNi 1.33\nTr 0.25\nillum 7\nKe 0 1 0\n");
-        assert_eq!(m.diffuse, Vec3::new(0.1, 0.2, 0.3));
+        assert_eq!(m.diffuse, Vec3::ONE, "glass without Tf is clear");
+        assert_eq!(m.model, MaterialModel::MetallicRoughness { metallic: 0.0, roughness: 0.0, transmission: 0.25 });
         assert_eq!((m.shininess, m.ior, m.transparency), (50.0, 1.33, 0.25));
         assert_eq!(m.reflectivity, 0.75, "Ks 0.9, capped at 1 - transparency");
         assert_eq!((m.emission, m.alpha), (Vec3::Y, Alpha::default()));
@@ -291,6 +378,83 @@ mod tests {
             assert!((m.transparency - 0.2).abs() < 1e-6 && m.reflectivity == 0.6, "{illum}");
         }
         assert_eq!(with(8).reflectivity, 0.0, "illum 8 reflects a map, not rays");
+    }
+
+    /// Base colour, metalness, roughness, transmission and index.
+    type Mapped = (Vec3, f32, f32, f32, f32);
+
+    /// The base colour, metalness, roughness, transmission and index of the material of `text`.
+    fn microfacet(text: &str) -> Mapped {
+        let (m, _) = one(text);
+        let MaterialModel::MetallicRoughness { metallic, roughness, transmission } = m.model else {
+            panic!("{:?}", m.model)
+        };
+        (m.diffuse, metallic, roughness, transmission, m.ior)
+    }
+
+    fn close(a: Mapped, b: Mapped) -> bool {
+        (a.0 - b.0).abs().max_element() < 1e-6
+            && [a.1 - b.1, a.2 - b.2, a.3 - b.3, a.4 - b.4].iter().all(|d| d.abs() < 1e-6)
+    }
+
+    #[test]
+    fn microfacet_mapping_row_by_row() {
+        let red = Vec3::new(0.6, 0.1, 0.1);
+        // Ns 98: alpha = sqrt(2 / 100), roughness = alpha^(1/2).
+        let r98 = (2.0f32 / 100.0).sqrt().sqrt();
+        let rows: [(&str, Mapped); 9] = [
+            // Ks black: Lambert, no layer (index 1), whatever Ni says.
+            ("Kd 0.6 0.1 0.1\nKs 0 0 0\nNs 98\nNi 1.5\nillum 2", (red, 0.0, r98, 0.0, 1.0)),
+            // illum 1 has no highlight: Ks is not read.
+            ("Kd 0.6 0.1 0.1\nKs 1 1 1\nNs 98\nillum 1", (red, 0.0, r98, 0.0, 1.0)),
+            // Plastic: Kd under a layer of index Ni, rough by Ns.
+            ("Kd 0.6 0.1 0.1\nKs 0.5 0.5 0.5\nNs 98\nNi 1.4\nillum 2", (red, 0.0, r98, 0.0, 1.4)),
+            // ... 1.5 where Ni is not above 1.
+            ("Kd 0.6 0.1 0.1\nKs 0.5\nNs 98\nNi 1\nillum 2", (red, 0.0, r98, 0.0, 1.5)),
+            // Kd black: a conductor of reflectance Ks.
+            ("Kd 0 0 0\nKs 0.9 0.6 0.2\nNs 98\nillum 2", (Vec3::new(0.9, 0.6, 0.2), 1.0, r98, 0.0, 1.0)),
+            // Mirrors: Kd 0.3 diffuse and a mirror of 0.6: base 0.9, metal share 2/3.
+            ("Kd 0.3\nKs 0.6\nNs 98\nillum 3", (Vec3::splat(0.9), 2.0 / 3.0, 0.0, 0.0, 1.0)),
+            // ... scaled down together above 1 (Fresnel mirror, illum 5), and a plain mirror.
+            ("Kd 0.8\nKs 0.8\nillum 5", (Vec3::ONE, 0.5, 0.0, 0.0, 1.0)),
+            ("Kd 0 0 0\nKs 1 1 1\nillum 3", (Vec3::ONE, 1.0, 0.0, 0.0, 1.0)),
+            // Glass: transmission 1 - d, index Ni, tint Tf.
+            ("Kd 0.5\nKs 1\nd 0.1\nNi 1.33\nTf 0.9 1 0.8\nillum 4", (Vec3::new(0.9, 1.0, 0.8), 0.0, 0.0, 0.9, 1.33)),
+        ];
+        for (body, want) in rows {
+            let got = microfacet(&format!("newmtl m\n{body}\n"));
+            assert!(close(got, want), "{body}: {got:?}, want {want:?}");
+        }
+        // illum 6 and 7 with d = 1 are mirrors; with d < 1, glass (Tf absent: clear, Ni absent: 1.5).
+        assert!(close(microfacet("newmtl m\nKd 0 0 0\nKs 1\nillum 7\n"), (Vec3::ONE, 1.0, 0.0, 0.0, 1.0)));
+        assert!(close(microfacet("newmtl m\nKd 0.2\nKs 1\nd 0\nillum 6\n"), (Vec3::ONE, 0.0, 0.0, 1.0, 1.5)));
+        // Ns absent: 32.
+        assert_eq!(microfacet("newmtl m\nKd 0.5\nKs 0.5\n").2, shininess_to_roughness(32.0));
+    }
+
+    #[test]
+    fn colour_forms_reach_the_material() {
+        // `Kd r` is grey; `Ks xyz` is converted; `Ka spectral` keeps the default (black) and warns.
+        let (m, _) = one("newmtl m\nKd 0.25\nKs xyz 0.9505 1.0 1.089\nKa spectral a.rfl\nillum 3\n");
+        assert!((m.specular - Vec3::ONE).abs().max_element() < 2e-3, "{}", m.specular);
+        let MaterialModel::MetallicRoughness { metallic, .. } = m.model else { panic!() };
+        assert!((metallic - 0.8).abs() < 1e-3, "Ks 1 beside Kd 0.25: {metallic}");
+        // `Tf xyz` tints glass.
+        let (m, _) = one("newmtl m\nTf xyz 0.5\nd 0\nillum 4\n");
+        assert!(
+            (m.diffuse - Vec3::new(0.6024, 0.4742, 0.4544).min(Vec3::ONE)).abs().max_element() < 1e-3,
+            "{}",
+            m.diffuse
+        );
+    }
+
+    #[test]
+    fn a_conductor_reads_its_colour_from_map_ks() {
+        let (m, _) = one("newmtl m\nKd 0 0 0\nKs 1 1 1\nmap_Kd kd.png\nmap_Ks ks.png\n");
+        let tex = |r: Option<TextureRef>| r.map(|r| r.texture);
+        assert_eq!(tex(m.textures.base_color), tex(m.textures.specular), "map_Ks is the conductor's colour");
+        let (m, _) = one("newmtl m\nKd 0.5 0.5 0.5\nKs 1 1 1\nmap_Kd kd.png\nmap_Ks ks.png\n");
+        assert_ne!(tex(m.textures.base_color), tex(m.textures.specular), "a plastic's base colour is map_Kd");
     }
 
     #[test]

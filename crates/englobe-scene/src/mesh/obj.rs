@@ -177,7 +177,8 @@ fn load_library(dir: &Path, name: &Path, state: &RefCell<Libraries>) -> tobj::MT
             continue;
         }
         match read_library(&file) {
-            Ok((mats, names, maps)) => {
+            Ok((mats, names, maps, warnings)) => {
+                state.borrow_mut().warnings.extend(warnings);
                 let offset = materials.len();
                 materials.extend(mats);
                 map.extend(names.into_iter().map(|(n, i)| (n, i + offset)));
@@ -215,14 +216,14 @@ fn split_names(list: &str) -> Vec<String> {
     names
 }
 
-type Library = (Vec<tobj::Material>, HashMap<String, usize>, mtl::MtlMaps);
+type Library = (Vec<tobj::Material>, HashMap<String, usize>, mtl::MtlMaps, Vec<String>);
 
 fn read_library(file: &Path) -> Result<Library, MeshFileError> {
     let text = utf8_text(file, read_limited(file, MAX_MTL_FILE_BYTES)?)?;
-    let maps = mtl::scan(file, &text)?;
-    let (materials, names) = guarded(file, "MTL", || tobj::load_mtl_buf(&mut text.as_bytes()))?
+    let scan = mtl::scan(file, &text)?;
+    let (materials, names) = guarded(file, "MTL", || tobj::load_mtl_buf(&mut scan.text.as_bytes()))?
         .map_err(|e| MeshFileError::file(file, MeshErrorKind::Parser(format!("tobj: {e}"))))?;
-    Ok((materials, names, maps))
+    Ok((materials, names, scan.maps, scan.warnings))
 }
 
 #[cfg(test)]
