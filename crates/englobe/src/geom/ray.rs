@@ -71,12 +71,9 @@ impl Ray {
     /// traversing anything.
     #[inline]
     pub fn is_valid(&self) -> bool {
-        // Every query starts here, so the six coordinates are checked in two vector operations:
-        // `x - x` is zero for a finite `x` and NaN for an infinite or NaN one, so the sum of both
-        // differences is zero exactly when all six are finite.
+        // Every query starts here, so the six coordinates are checked with vector comparisons.
         let (o, d) = (Vec3A::from(self.origin), Vec3A::from(self.dir));
-        let finite = ((o - o) + (d - d)).cmpeq(Vec3A::ZERO).all();
-        finite
+        (o.is_finite_mask() & d.is_finite_mask()).all()
             && d.cmpne(Vec3A::ZERO).any()
             && self.t_min <= self.t_max
             && self.t_min < f32::INFINITY
