@@ -32,7 +32,9 @@ fn info_describes_mesh_files() {
     assert!(
         shown.contains("materials:  8")
             && shown.contains("light: metallic_roughness, base colour [0.78, 0.78, 0.78],")
-            && shown.contains("shortBox: metallic_roughness, base colour [0.725, 0.71, 0.68], metallic 0, roughness 0.3154421")
+            && shown.contains(
+                "shortBox: metallic_roughness, base colour [0.725, 0.71, 0.68], metallic 0, roughness 0.3154421"
+            )
             && shown.contains("emission [17, 12, 4], 2 triangles")
             && shown.contains("textures:   0 (0 unreadable)"),
         "{shown}"

@@ -290,7 +290,8 @@ fn phases_are_shown_on_a_terminal_with_counts_and_times_and_never_in_a_pipe() {
     let scene = repo_root().join("scenes/bunny.toml").display().to_string();
     let shown = on_a_terminal(dir.path(), &format!("render {scene} --scale 0.1 --spp 1 -o b.png"));
     assert!(shown.contains(&format!("loaded {scene} in ")), "{shown}");
-    assert!(shown.contains("(69451 triangles in the picture), 2 lights"), "{shown}");
+    assert!(shown.contains("(69451 triangles in the picture from 1 mesh file(s)), 2 lights"), "{shown}");
+    assert!(shown.contains("stanford-bunny.obj: 69451 triangles in "), "the mesh file's own phase: {shown}");
     assert!(shown.contains("built bvh-wide in ") && shown.contains(" s over 69451 triangles"), "{shown}");
     let quiet = on_a_terminal(dir.path(), &format!("render {scene} --scale 0.1 --spp 1 -q -o b.png"));
     assert!(!quiet.contains("loaded") && !quiet.contains("wrote"), "{quiet}");
