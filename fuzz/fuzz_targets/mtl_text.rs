@@ -1,4 +1,5 @@
-//! MTL material libraries: every statement and texture option checked, never a panic.
+//! MTL material libraries: every statement and texture option checked, and each material mapped
+//! onto englobe's materials, never a panic.
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;

@@ -71,12 +71,20 @@ fn read_mesh_file(path: &Path) -> Result<LoadedMesh, MeshFileError> {
 
 /// Checks the text of an MTL material library as OBJ loading does (every statement, texture
 /// statements and their options included, then `tobj`'s parse of the text as englobe rewrites
-/// it), without reading the textures; `path` names it in errors.
+/// it, then each material's mapping onto englobe's materials), without reading the textures;
+/// `path` names it in errors.
 pub fn check_mtl_text(path: &Path, text: &str) -> Result<(), MeshFileError> {
     let scan = mtl::scan(path, text)?;
-    read::guarded(path, "MTL", || tobj::load_mtl_buf(&mut scan.text.as_bytes()))?
-        .map(|_| ())
-        .map_err(|e| MeshFileError::file(path, MeshErrorKind::Parser(format!("tobj: {e}"))))
+    let (materials, _) = read::guarded(path, "MTL", || tobj::load_mtl_buf(&mut scan.text.as_bytes()))?
+        .map_err(|e| MeshFileError::file(path, MeshErrorKind::Parser(format!("tobj: {e}"))))?;
+    // The numbers of every material through the same mapping as a loaded OBJ's (no texture
+    // statement is passed, so no file is read).
+    let dir = path.parent().unwrap_or(Path::new(""));
+    let mut textures = mtl_material::MtlTextures::default();
+    for m in &materials {
+        mtl_material::to_material(m, &[], dir, &mut textures);
+    }
+    Ok(())
 }
 
 /// Reads and checks a mesh already in memory, as it is in the file (no normals or tangents
