@@ -111,7 +111,7 @@ pub fn run(args: ExperimentArgs) -> anyhow::Result<ExitCode> {
         images: args.images,
     };
     let quiet = args.quiet;
-    let experiment = run_seed(&options, &mut |line| {
+    let experiment = run_seed(&options, &mut |line: &str| {
         if !quiet {
             eprintln!("{line}");
         }
@@ -158,11 +158,7 @@ fn samplers(args: ExperimentArgs) -> anyhow::Result<ExitCode> {
         options.reference_spp = spp;
     }
     let quiet = args.quiet;
-    let experiment = run_samplers(&options, &mut |line| {
-        if !quiet {
-            eprintln!("{line}");
-        }
-    })?;
+    let experiment = run_samplers(&options, &mut progress(quiet))?;
     print!("{}", experiment.table());
     if let Some(path) = &args.json {
         englobe_lab::report::write_json(path, &experiment)?;
@@ -193,14 +189,19 @@ fn fewer_rays(args: ExperimentArgs) -> anyhow::Result<ExitCode> {
     options.path_size = args.path_size.unwrap_or(options.path_size);
     options.reference_samples = args.reference_spp.unwrap_or(options.reference_samples);
     let quiet = args.quiet;
-    let experiment = run_fewer_rays(&options, &mut |line| {
-        if !quiet {
-            eprintln!("{line}");
-        }
-    })?;
+    let experiment = run_fewer_rays(&options, &mut progress(quiet))?;
     print!("{}", experiment.table());
     if let Some(path) = &args.json {
         englobe_lab::report::write_json(path, &experiment)?;
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// The experiments' progress lines, on standard error unless `quiet`.
+fn progress(quiet: bool) -> impl FnMut(String) {
+    move |line| {
+        if !quiet {
+            eprintln!("{line}");
+        }
+    }
 }
