@@ -43,7 +43,8 @@ pub struct ImageOptions {
     /// Adaptive sampling: every 8x8 block of pixels stops once its estimated relative error falls
     /// under this (0.01 is fine, 0.05 a preview; 0 turns it off); the same as
     /// -D image.noise_threshold=T. The first pass is image.min_samples (default, as Cycles:
-    /// 16 / T^0.3, so 64 at 0.01).
+    /// 16 / T^0.3, so 64 at 0.01). -D image.noise_allocation=mse shares the samples for the
+    /// least squared error instead of an even noise.
     #[arg(long, value_name = "T", value_parser = parse_threshold)]
     pub noise_threshold: Option<f32>,
     /// Acceleration structure: bvh-wide (the fast path, eight-wide at both levels), none (brute

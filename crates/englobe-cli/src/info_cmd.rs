@@ -1,7 +1,7 @@
 //! `englobe info FILE`: what a mesh file or a scene file holds (triangles, vertices, bounds,
 //! materials with their model, factors and texture slots, textures with their sizes and which
 //! could not be read, instances, warnings), or the error that refuses it; for an OpenEXR image,
-//! its mean colour (see [`crate::image_stats`]).
+//! its mean colour, and how it differs from a reference image (see [`crate::image_stats`]).
 
 use std::collections::HashSet;
 use std::fmt::Write as _;
@@ -21,6 +21,10 @@ pub struct InfoArgs {
     /// For an OpenEXR image: also the mean RGB of the pixels X0..X1, Y0..Y1 (row 0 at the top).
     #[arg(long, value_name = "X0,Y0,X1,Y1", value_parser = crate::image_stats::parse_patch)]
     patch: Option<crate::image_stats::Patch>,
+    /// For an OpenEXR image: how it differs from this reference image of the same size (ratio of
+    /// the means, of the patch's means, RMSE and relative MSE), as when comparing renderers.
+    #[arg(long, value_name = "REFERENCE.exr")]
+    against: Option<PathBuf>,
     /// For a pbrt scene: refuse it, at the first thing englobe would skip or approximate, instead
     /// of listing those as warnings.
     #[arg(long)]
@@ -30,9 +34,12 @@ pub struct InfoArgs {
 pub fn run(args: InfoArgs) -> anyhow::Result<ExitCode> {
     let is_scene = args.file.extension().is_some_and(|e| e.eq_ignore_ascii_case("toml"));
     let is_image = args.file.extension().is_some_and(|e| e.eq_ignore_ascii_case("exr"));
-    anyhow::ensure!(is_image || args.patch.is_none(), "--patch is for OpenEXR images");
+    anyhow::ensure!(
+        is_image || (args.patch.is_none() && args.against.is_none()),
+        "--patch and --against are for OpenEXR images"
+    );
     let text = if is_image {
-        crate::image_stats::image_info(&args.file, args.patch)?
+        crate::image_stats::image_info(&args.file, args.patch, args.against.as_deref())?
     } else if englobe_scene::pbrt::is_pbrt_path(&args.file) {
         scene_info(&args.file, &englobe_scene::pbrt::load(&args.file, args.strict)?)
     } else if is_scene {

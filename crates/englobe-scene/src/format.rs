@@ -59,6 +59,8 @@ pub struct ImageDef {
     pub min_contribution: Option<crate::numbers::Fraction>,
     pub noise_threshold: Option<crate::numbers::NonNegative>,
     pub min_samples: Option<Spanned<u32>>,
+    #[serde(default)]
+    pub noise_allocation: crate::model::NoiseAllocation,
     pub background: Option<Color>,
     pub ambient: Option<Color>,
     #[serde(default)]

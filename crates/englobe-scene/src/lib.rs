@@ -36,7 +36,7 @@ pub use material::{
 pub use material_eval::{MISSING_TEXTURE_COLOR, SurfaceParams};
 pub use model::{
     Camera, ImageSettings, IntegratorKind, Light, MAX_DEPTH, MAX_PIXELS, MAX_SAMPLES, Material, MaterialId,
-    OutputSettings, Projection, SamplerKind, Scene, SceneObject, TextureFilter, ToneMap,
+    NoiseAllocation, OutputSettings, Projection, SamplerKind, Scene, SceneObject, TextureFilter, ToneMap,
 };
 pub use overrides::Override;
 pub use parse::{

@@ -43,6 +43,9 @@ pub struct ImageSettings {
     /// Samples of adaptive sampling's first pass, before any block may stop (`None`: as Cycles
     /// chooses them, `16 / noise_threshold^0.3`); at most `samples`.
     pub min_samples: Option<u32>,
+    /// How adaptive sampling shares the samples among blocks: every block down to the
+    /// threshold, or as many as lower the image's squared error most.
+    pub noise_allocation: NoiseAllocation,
     /// Colour of rays that hit nothing (linear RGB).
     pub background: Vec3,
     /// Light that reaches every point, scaled by the diffuse colour (the classic ambient term).
@@ -66,6 +69,33 @@ pub struct ImageSettings {
     /// How textures are read at a ray's hit: at the point, or over the footprint of the ray's
     /// cone (englobe-render's `ray_cone`).
     pub texture_filter: TextureFilter,
+}
+
+/// How adaptive sampling shares its samples among the blocks of pixels (englobe-render's
+/// `adaptive`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Deserialize, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum NoiseAllocation {
+    /// Every block samples until its estimated error falls under the threshold, as Cycles and
+    /// RenderMan do: the noise looks even over the image. A block with `k` times the noise of
+    /// another takes `k^2` times its samples.
+    #[default]
+    Even,
+    /// A block stops once one more sample would lower the image's squared error less than it
+    /// would for a block at the threshold after the first pass: a block with `k` times the noise
+    /// of another takes `k` times its samples, the split of a budget that minimises the image's
+    /// mean squared error. Noisy regions end noisier than the threshold, quiet ones as `even`.
+    Mse,
+}
+
+impl NoiseAllocation {
+    /// The name used in scene files.
+    pub fn name(self) -> &'static str {
+        match self {
+            NoiseAllocation::Even => "even",
+            NoiseAllocation::Mse => "mse",
+        }
+    }
 }
 
 /// How textures are read where a ray hits them.

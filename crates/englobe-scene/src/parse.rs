@@ -280,6 +280,7 @@ impl Converter<'_> {
             min_contribution: i.min_contribution.map_or(0.0, |f| f.0),
             noise_threshold: i.noise_threshold.map_or(0.0, |f| f.0),
             min_samples: i.min_samples.map(|m| *m.get_ref()),
+            noise_allocation: i.noise_allocation,
             background: i.background.map_or(Vec3::ZERO, |c| c.0),
             ambient: i.ambient.map_or(Vec3::ZERO, |c| c.0),
             seed: i.seed,

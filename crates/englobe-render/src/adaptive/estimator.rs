@@ -45,7 +45,7 @@
 //! where noise is even.
 
 use englobe::Vec3;
-use englobe_scene::ImageSettings;
+use englobe_scene::{ImageSettings, NoiseAllocation};
 
 /// Side of the blocks that stop together, in pixels (the image's blocks start at its corner).
 pub const BLOCK_SIZE: u32 = 8;
@@ -65,8 +65,11 @@ const EPSILON: f32 = 1e-4;
 /// When to stop sampling a block, and the bounds of its samples.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct AdaptiveSampling {
-    /// A block stops once its error (see the module's documentation) falls under this.
+    /// A block stops once its error (see the module's documentation) falls under this, or under
+    /// this times `sqrt(n / min_samples)` with the `mse` allocation.
     pub threshold: f32,
+    /// How the samples are shared (see [`AdaptiveSampling::converged`]).
+    pub allocation: NoiseAllocation,
     /// Samples every pixel takes before any block may stop (2 at least).
     pub min_samples: u32,
     /// Samples no pixel goes beyond.
@@ -83,6 +86,7 @@ impl AdaptiveSampling {
         let min = image.min_samples.unwrap_or_else(|| default_min_samples(image.noise_threshold, samples));
         Some(AdaptiveSampling {
             threshold: image.noise_threshold,
+            allocation: image.noise_allocation,
             min_samples: min.clamp(2, samples),
             max_samples: samples,
         })
@@ -94,10 +98,24 @@ impl AdaptiveSampling {
         if taken == 0 { self.min_samples } else { taken.saturating_add(taken.div_ceil(4)).min(self.max_samples) }
     }
 
-    /// Whether a block with this error (the mean of its pixels' errors) has converged. NaN (a
-    /// sample that was not a number) never converges, so such a block takes every sample.
-    pub fn converged(&self, block_error: f32) -> bool {
-        block_error < self.threshold
+    /// Whether a block with this error (the mean of its pixels' errors) after `n` samples per
+    /// pixel has converged. NaN (a sample that was not a number) never converges, so such a
+    /// block takes every sample.
+    ///
+    /// `even`: the error is under the threshold `T`. `mse`: a block's error is `s / sqrt(n)` for
+    /// a noise `s` of its own, so one more sample lowers its squared error by about
+    /// `s^2 / n^2 = error^2 / n`; the block stops once that falls under what a block at the
+    /// threshold after the first pass would gain, `T^2 / min_samples`, that is once
+    /// `error < T sqrt(n / min_samples)`. Blocks then end with `n` proportional to `s`, which is
+    /// the split of a number of samples that minimises the sum of squared errors (Lagrange: the
+    /// gain of the last sample is the same everywhere), where `even`'s `n` grows as `s^2` and
+    /// gives the same squared error as uniform sampling wherever no block stops at the first
+    /// pass or at the maximum.
+    pub fn converged(&self, block_error: f32, n: u32) -> bool {
+        match self.allocation {
+            NoiseAllocation::Even => block_error < self.threshold,
+            NoiseAllocation::Mse => block_error < self.threshold * (n as f32 / self.min_samples.max(1) as f32).sqrt(),
+        }
     }
 }
 
@@ -184,7 +202,8 @@ mod tests {
 
     #[test]
     fn passes_grow_by_a_quarter_up_to_the_maximum() {
-        let a = AdaptiveSampling { threshold: 0.01, min_samples: 16, max_samples: 100 };
+        let a =
+            AdaptiveSampling { threshold: 0.01, allocation: NoiseAllocation::Even, min_samples: 16, max_samples: 100 };
         let mut totals = vec![];
         let mut taken = 0;
         while taken < a.max_samples {
@@ -192,8 +211,29 @@ mod tests {
             totals.push(taken);
         }
         assert_eq!(totals, [16, 20, 25, 32, 40, 50, 63, 79, 99, 100]);
-        let two = AdaptiveSampling { threshold: 0.01, min_samples: 2, max_samples: 5 };
+        let two =
+            AdaptiveSampling { threshold: 0.01, allocation: NoiseAllocation::Even, min_samples: 2, max_samples: 5 };
         assert_eq!((two.next_total(0), two.next_total(2), two.next_total(4), two.next_total(5)), (2, 3, 5, 5));
+    }
+
+    #[test]
+    fn the_mse_allocation_relaxes_the_threshold_as_the_root_of_the_samples() {
+        let even =
+            AdaptiveSampling { threshold: 0.02, allocation: NoiseAllocation::Even, min_samples: 16, max_samples: 4096 };
+        let mse = AdaptiveSampling { allocation: NoiseAllocation::Mse, ..even };
+        // At the first pass both ask for the threshold.
+        assert_eq!((even.converged(0.0199, 16), mse.converged(0.0199, 16)), (true, true));
+        assert_eq!((even.converged(0.0201, 16), mse.converged(0.0201, 16)), (false, false));
+        // At 64 samples (four times the first pass) mse accepts twice the threshold.
+        assert_eq!((even.converged(0.039, 64), mse.converged(0.039, 64)), (false, true));
+        assert!(!mse.converged(0.041, 64));
+        // A block of noise s stops where s / sqrt(n) < T sqrt(n / 16): n > 4 s / T. Twice the
+        // noise, twice the samples (even: four times).
+        let stop = |a: &AdaptiveSampling, s: f32| (16..4096).find(|&n| a.converged(s / (n as f32).sqrt(), n)).unwrap();
+        let (n1, n2) = (stop(&mse, 0.2), stop(&mse, 0.4));
+        assert!((n2 as f32 / n1 as f32 - 2.0).abs() < 0.05, "{n1} {n2}");
+        let (e1, e2) = (stop(&even, 0.2), stop(&even, 0.4));
+        assert!((e2 as f32 / e1 as f32 - 4.0).abs() < 0.05, "{e1} {e2}");
     }
 
     #[test]
@@ -222,7 +262,10 @@ mod tests {
         (0..6).for_each(|i| flat.add(i, Vec3::splat(0.3)));
         assert_eq!(flat.error(6), 0.0);
         assert_eq!(HalfSums::default().error(4), 0.0);
-        assert!(!AdaptiveSampling { threshold: 1.0, min_samples: 2, max_samples: 2 }.converged(f32::NAN));
+        let even =
+            AdaptiveSampling { threshold: 1.0, allocation: NoiseAllocation::Even, min_samples: 2, max_samples: 2 };
+        assert!(!even.converged(f32::NAN, 2));
+        assert!(!AdaptiveSampling { allocation: NoiseAllocation::Mse, ..even }.converged(f32::NAN, 2));
     }
 
     #[test]

@@ -164,7 +164,7 @@ impl Renderer<'_> {
                 block.pixels = pixels;
                 block.taken = target;
                 block.done = target >= adaptive.max_samples
-                    || adaptive.converged(block_error(block.pixels.iter().map(|p| &p.sums), target));
+                    || adaptive.converged(block_error(block.pixels.iter().map(|p| &p.sums), target), target);
                 stats.add(&pass_stats);
             }
             taken = target;

@@ -79,6 +79,7 @@ impl Builder {
             output: Default::default(),
             noise_threshold: 0.0,
             min_samples: None,
+            noise_allocation: Default::default(),
             texture_filter: Default::default(),
         };
         Ok((image, camera))
