@@ -5,7 +5,7 @@
 
 Mitsuba 3 does not read pbrt files, so this script reads the small subset of pbrt-v4 that the
 Cornell box uses (Transform, Camera "perspective" fov, Film resolution, Sampler pixelsamples,
-Integrator maxdepth, PixelFilter "triangle" radius, MakeNamedMaterial/NamedMaterial "diffuse"
+Integrator maxdepth, PixelFilter "triangle" radius or "box", MakeNamedMaterial/NamedMaterial "diffuse"
 with an rgb reflectance, Shape "trianglemesh" P and indices, AttributeBegin/End and
 AreaLightSource "diffuse" rgb L) and refuses anything else by name, so that the two renderers
 are known to see the same scene. The translation, each point stated where the two differ:
@@ -16,7 +16,10 @@ are known to see the same scene. The translation, each point stated where the tw
 - pbrt's fov is on the shorter image axis: Mitsuba's `fov_axis = "smaller"`.
 - pbrt's `maxdepth` counts bounces (1 = direct light only); Mitsuba's `max_depth` counts path
   vertices (2 = direct light only), so Mitsuba gets maxdepth + 1.
-- pbrt's triangle filter of radius r is Mitsuba's `tent` of radius r.
+- pbrt's triangle filter of radius r is Mitsuba's `tent` of radius r; pbrt's box of radius 0.5
+  is Mitsuba's `box`. Mitsuba adds each sample to every pixel its filter reaches (splatting), pbrt
+  and englobe to one pixel, the filter drawn as the sample's offset, so with a filter wider than a
+  pixel Mitsuba's pixels average more samples and are less noisy, and correlated.
 - pbrt's diffuse material reflects on both sides: Mitsuba's `diffuse` inside `twosided`.
 - pbrt's area light emits on the side its geometric normal points to, as Mitsuba's `area` does.
 - The `rgb` variant renders in linear RGB, as englobe does (pbrt-v4 renders spectrally).
@@ -104,7 +107,8 @@ def write_ply(path, points, indices):
 
 
 def scene_dict(mi, directives, folder, spp, seed):
-    world_to_camera, fov, res, depth, radius = None, None, [1280, 720], 5, 1.0
+    world_to_camera, fov, res, depth = None, None, [1280, 720], 5
+    pixel_filter = {"type": "gaussian"}
     materials, current, light, in_attr, shapes = {}, None, None, False, {}
     saved = None
     for name, args, params in directives:
@@ -123,12 +127,15 @@ def scene_dict(mi, directives, folder, spp, seed):
                 sys.exit(f"Integrator {args}: only path is read")
             depth = int(floats(params, "integer maxdepth", [5])[0])
         elif name == "PixelFilter":
-            if args != ["triangle"]:
-                sys.exit(f"PixelFilter {args}: only triangle is read")
-            rx, ry = floats(params, "float xradius", [2.0])[0], floats(params, "float yradius", [2.0])[0]
+            if args not in (["triangle"], ["box"]):
+                sys.exit(f"PixelFilter {args}: only triangle and box are read")
+            default = [2.0] if args == ["triangle"] else [0.5]
+            rx, ry = floats(params, "float xradius", default)[0], floats(params, "float yradius", default)[0]
             if rx != ry:
-                sys.exit("PixelFilter: Mitsuba's tent filter has one radius")
-            radius = rx
+                sys.exit("PixelFilter: Mitsuba's filters have one radius")
+            if args == ["box"] and rx != 0.5:
+                sys.exit("PixelFilter box: Mitsuba's box filter has radius 0.5")
+            pixel_filter = {"type": "tent", "radius": rx} if args == ["triangle"] else {"type": "box"}
         elif name == "WorldBegin":
             pass
         elif name == "MakeNamedMaterial":
@@ -183,7 +190,7 @@ def scene_dict(mi, directives, folder, spp, seed):
                 "width": res[0],
                 "height": res[1],
                 "pixel_format": "rgb",
-                "rfilter": {"type": "tent", "radius": radius},
+                "rfilter": pixel_filter,
             },
         },
     }
