@@ -88,7 +88,7 @@ pub fn mesh_info(path: &Path, m: &LoadedMesh) -> String {
         )
     };
     let _ = writeln!(out, "normals:    {normals}");
-    let _ = writeln!(out, "uvs:        {}", yes(mesh.uvs().is_some()));
+    let _ = writeln!(out, "uvs:        {}", uv_sets_text(mesh));
     let _ = writeln!(out, "tangents:   {}", yes(m.tangents.is_some()));
     bounds_lines(&mut out, &mesh.bounds());
     let _ = writeln!(out, "memory:     {} bytes (vertices, triangles and attributes)", mesh_bytes(mesh));
@@ -100,6 +100,16 @@ pub fn mesh_info(path: &Path, m: &LoadedMesh) -> String {
     textures_lines(&mut out, &m.textures, m.materials.iter().map(|(n, m)| (n.as_str(), m)));
     warnings_lines(&mut out, &m.warnings);
     out
+}
+
+/// The texture coordinate sets a mesh keeps: `no`, `yes (set 0)`, `yes (sets 0, 1)`.
+fn uv_sets_text(mesh: &TriangleMesh) -> String {
+    let sets: Vec<String> = (0..2).filter(|&s| mesh.uv_set(s).is_some()).map(|s| s.to_string()).collect();
+    match sets.len() {
+        0 => "no".to_owned(),
+        1 => format!("yes (set {})", sets[0]),
+        _ => format!("yes (sets {})", sets.join(", ")),
+    }
 }
 
 /// A material's model, factors and texture slots on one line.
@@ -137,6 +147,9 @@ fn material_text(m: &Material, textures: &[std::sync::Arc<Texture>]) -> String {
     for (slot, r) in m.textures.slots() {
         let name = textures.get(r.texture as usize).map_or("(missing)", |t| t.name.as_str());
         let _ = write!(s, ", {slot} texture {name}");
+        if r.uv_set != 0 {
+            let _ = write!(s, " (uv set {})", r.uv_set);
+        }
     }
     s
 }
@@ -179,6 +192,7 @@ pub fn mesh_bytes(m: &TriangleMesh) -> usize {
         + std::mem::size_of_val(m.triangles())
         + m.normals().map_or(0, std::mem::size_of_val)
         + m.uvs().map_or(0, std::mem::size_of_val)
+        + m.uvs1().map_or(0, std::mem::size_of_val)
 }
 
 /// The description of a loaded scene.
@@ -261,4 +275,22 @@ pub fn scene_info(path: &Path, scene: &Scene) -> String {
     textures_lines(&mut out, &scene.textures, scene.material_names.iter().map(String::as_str).zip(&scene.materials));
     warnings_lines(&mut out, &scene.warnings);
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use englobe::{Vec2, Vec3};
+
+    use super::*;
+
+    #[test]
+    fn the_uvs_line_names_the_sets() {
+        let tri = TriangleMesh::new(vec![Vec3::ZERO, Vec3::X, Vec3::Y], vec![[0, 1, 2]]).unwrap();
+        assert_eq!(uv_sets_text(&tri), "no");
+        let one = tri.clone().with_uvs(vec![Vec2::ZERO; 3]).unwrap();
+        assert_eq!(uv_sets_text(&one), "yes (set 0)");
+        let two = one.clone().with_uvs1(vec![Vec2::ONE; 3]).unwrap();
+        assert_eq!(uv_sets_text(&two), "yes (sets 0, 1)");
+        assert_eq!(mesh_bytes(&two), mesh_bytes(&one) + 3 * std::mem::size_of::<Vec2>());
+    }
 }

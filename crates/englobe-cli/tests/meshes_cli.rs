@@ -52,6 +52,7 @@ fn info_lists_materials_and_textures_and_what_could_not_be_read() {
         "normal texture Default_normal.jpg",
         "textures:   5 (0 unreadable)",
         "Default_albedo.jpg): 2048x2048, 3 channels, 8 bits; used as Material_MR base_color",
+        "uvs:        yes (set 0)",
         "tangents:   yes",
     ] {
         assert!(shown.contains(line), "{line:?} missing from:\n{shown}");

@@ -83,7 +83,8 @@ pub fn scene_digest(scene: &Scene, options: &str) -> String {
     h.finalize().to_hex().to_string()
 }
 
-/// The digest of one mesh's positions, triangles, normals and texture coordinates, bit for bit.
+/// The digest of one mesh's positions, triangles, normals and texture coordinates (both sets),
+/// bit for bit.
 fn hash_mesh(mesh: &TriangleMesh) -> [u8; 32] {
     let mut h = blake3::Hasher::new();
     let mut floats = |label: &[u8], values: &mut dyn Iterator<Item = f32>| {
@@ -101,6 +102,9 @@ fn hash_mesh(mesh: &TriangleMesh) -> [u8; 32] {
     }
     if let Some(uvs) = mesh.uvs() {
         floats(b"uvs", &mut uvs.iter().flat_map(|p| p.to_array()));
+    }
+    if let Some(uvs) = mesh.uvs1() {
+        floats(b"uvs1", &mut uvs.iter().flat_map(|p| p.to_array()));
     }
     h.update(b"triangles");
     for t in mesh.triangles() {

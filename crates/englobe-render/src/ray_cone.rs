@@ -71,16 +71,18 @@ impl RayCone {
     }
 }
 
-/// The footprint in texture coordinates of a cone `width` wide arriving along the unit direction
-/// `d` on triangle `prim` of `object` (a mesh, or an instance of one); `None` for shapes, meshes
-/// without texture coordinates, and degenerate triangles or coordinates.
-pub fn footprint(object: &SceneObject, prim: u32, d: Vec3, width: f32) -> Option<UvFootprint> {
+/// The footprint in texture coordinate set `set` (0 or 1) of a cone `width` wide arriving along
+/// the unit direction `d` on triangle `prim` of `object` (a mesh, or an instance of one); `None`
+/// for shapes, meshes without that set, and degenerate triangles or coordinates. Each set has
+/// its own: the same patch of surface covers more or less of the image depending on how much of
+/// it a set spreads over the triangle.
+pub fn footprint(object: &SceneObject, set: u32, prim: u32, d: Vec3, width: f32) -> Option<UvFootprint> {
     let (mesh, to_world) = match &object.object {
         Object::Mesh(m) => (&**m, None),
         Object::Instance(i) => (&**i.mesh(), Some(i.to_world())),
         Object::Shape(_) => return None,
     };
-    let uvs = mesh.uvs()?;
+    let uvs = mesh.uv_set(set)?;
     let tri = *mesh.triangles().get(prim as usize)?;
     let p = tri.map(|i| {
         let p = mesh.positions()[i as usize];
@@ -139,7 +141,7 @@ mod tests {
         assert!((cone.spread - a).abs() < 1e-9);
         let object = SceneObject::new(Object::Mesh(Arc::new(square(4.0))), 0);
         for d in [10.0f32, 3.0, 50.0] {
-            let f = footprint(&object, 1, Vec3::Z, cone.width_at(d)).unwrap();
+            let f = footprint(&object, 0, 1, Vec3::Z, cone.width_at(d)).unwrap();
             let plan = FilterPlan::new(f, 1024, 1024).unwrap();
             let expected = (d * a * 256.0).log2();
             assert_eq!(plan.probes, 1);
@@ -156,14 +158,30 @@ mod tests {
         // projection (x here) as across it (y).
         let object = SceneObject::new(Object::Mesh(Arc::new(square(1.0))), 0);
         let d = Vec3::new(60f32.to_radians().sin(), 0.0, 60f32.to_radians().cos());
-        let f = footprint(&object, 0, d, 0.1).unwrap();
+        let f = footprint(&object, 0, 0, d, 0.1).unwrap();
         assert!((f.axes[0] - Vec2::new(0.1, 0.0)).length() < 1e-5, "{:?}", f.axes);
         assert!((f.axes[1].abs() - Vec2::new(0.0, 0.05)).length() < 1e-5, "{:?}", f.axes);
         // An instance scaled by 2 halves the footprint in texture coordinates.
         let inst = Instance::new(Arc::new(square(1.0)), Affine3A::from_scale(Vec3::splat(2.0))).unwrap();
         let object = SceneObject::new(Object::Instance(inst), 0);
-        let f = footprint(&object, 0, Vec3::Z, 0.1).unwrap();
+        let f = footprint(&object, 0, 0, Vec3::Z, 0.1).unwrap();
         assert!((f.axes[0].length() - 0.025).abs() < 1e-6 && (f.axes[1].length() - 0.025).abs() < 1e-6);
+    }
+
+    #[test]
+    fn each_coordinate_set_has_its_own_footprint() {
+        // Set 1 spreads a quarter of the image over the square (a light map's tile, say): its
+        // footprint is a quarter of set 0's; a mesh without set 1 has no footprint there.
+        let one = square(1.0);
+        assert!(footprint(&SceneObject::new(Object::Mesh(Arc::new(one.clone())), 0), 1, 0, Vec3::Z, 0.1).is_none());
+        let quarter = one.uvs().unwrap().iter().map(|uv| *uv * 0.25).collect();
+        let object = SceneObject::new(Object::Mesh(Arc::new(one.with_uvs1(quarter).unwrap())), 0);
+        let f0 = footprint(&object, 0, 0, Vec3::Z, 0.1).unwrap();
+        let f1 = footprint(&object, 1, 0, Vec3::Z, 0.1).unwrap();
+        for k in 0..2 {
+            assert!((f0.axes[k].length() - 0.05).abs() < 1e-6, "{:?}", f0.axes);
+            assert!((f1.axes[k].length() - 0.0125).abs() < 1e-6, "{:?}", f1.axes);
+        }
     }
 
     #[test]

@@ -10,7 +10,7 @@
 //! tracer reflects them with the BSDF `diffuse / π` (see [`crate::light_sampling`]).
 
 use englobe::{Counters, Object, Ray, Vec3, World, WorldHit};
-use englobe_scene::{Light, Material, MaterialModel, Scene, SurfaceParams};
+use englobe_scene::{Light, Material, MaterialModel, Scene, SurfaceParams, TexCoords};
 
 use crate::optics::offset_ray_origin;
 use crate::ray_cone::{RayCone, footprint};
@@ -40,7 +40,7 @@ pub struct Surface<'a> {
 
 impl<'a> Surface<'a> {
     /// The surface at `hit` of `ray`: the material's textures read at the hit's texture
-    /// coordinate, the shading normal bent by its normal map (in the frame of the mesh's tangents,
+    /// coordinates (each in the set it names), the shading normal bent by its normal map (in the frame of the mesh's tangents,
     /// moved into the world by an instance's transform).
     pub fn at(scene: &'a Scene, world: &World, ray: &Ray, hit: &WorldHit) -> Self {
         Self::at_over(scene, world, ray, hit, None)
@@ -56,12 +56,21 @@ impl<'a> Surface<'a> {
         let geometric = world.geometric_normal(hit, p);
         let entering = d.dot(geometric) < 0.0;
         let n = if entering { geometric } else { -geometric };
-        let uv = if material.textures.is_empty() { None } else { object.uv(hit.prim, hit.u, hit.v) };
-        let area = match (cone, uv) {
-            (Some(c), Some(_)) => footprint(object, hit.prim, d, c.width_at((p - ray.origin()).length())),
-            _ => None,
-        };
-        let params = material.evaluate_over(&scene.textures, uv, area);
+        // Set 1 is interpolated only for materials that read it; each set gets its own
+        // footprint, since the two map the triangle onto their images differently.
+        let mut coords = TexCoords::default();
+        if !material.textures.is_empty() {
+            coords = object.tex_coords(material.textures.reads_set1(), hit.prim, hit.u, hit.v);
+            if let Some(c) = cone {
+                let width = c.width_at((p - ray.origin()).length());
+                for set in 0..2 {
+                    if coords.uv[set].is_some() {
+                        coords.footprint[set] = footprint(object, set as u32, hit.prim, d, width);
+                    }
+                }
+            }
+        }
+        let params = material.evaluate_at(&scene.textures, &coords);
         let mut shading = world.shading_normal(hit, p);
         if let (Some(bent), Some(tangent)) = (params.normal_ts, object.tangent(hit.prim, hit.u, hit.v)) {
             let (t, w) = match &world.objects()[hit.object as usize] {

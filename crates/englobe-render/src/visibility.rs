@@ -2,7 +2,8 @@
 //! the texels of a surface that are cut out (glTF `alphaMode` `MASK`, MTL `d` and `map_d`) or, in
 //! proportion to their transparency, partly covered (`BLEND`). This is the any-hit filter of the
 //! traversal, as Embree's intersection filter functions do it: a rejected candidate is as if its
-//! triangle were not there, for closest-hit and shadow rays alike.
+//! triangle were not there, for closest-hit and shadow rays alike. The coverage is read in the
+//! texture coordinate set of the texture that holds it (the base colour texture's, in glTF).
 //!
 //! A partly covered surface is passed through with probability `1 - alpha` (stochastic
 //! transparency, Enderton, Sintorn, Shirley and Luebke 2010), decided by a hash of the hit (object,
@@ -57,7 +58,10 @@ impl<'a> Visibility<'a> {
         if m.culls_back_faces() && self.is_back_face(ray, hit) {
             return false;
         }
-        !m.has_cutouts() || !m.passes_through(&self.scene.textures, object.uv(hit.prim, hit.u, hit.v), hit_number(hit))
+        // The coverage is read in the set of the texture that holds it (the base colour's in glTF).
+        let set1 = m.textures.coverage_set() == 1;
+        !m.has_cutouts()
+            || !m.passes_through(&self.scene.textures, object.tex_coords(set1, hit.prim, hit.u, hit.v), hit_number(hit))
     }
 
     /// True when `ray` meets the triangle of `hit` from behind. Other shapes have no back face

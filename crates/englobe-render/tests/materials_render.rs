@@ -1,6 +1,7 @@
 //! Materials in the integrators: a cut-out texel is passed through by closest-hit and shadow
 //! queries alike, in every structure, and partly covered surfaces are passed through by both
-//! kinds of query at the same points; the back faces of single-sided materials are culled by both
+//! kinds of query at the same points, reading the coverage in the base colour texture's
+//! coordinate set; the back faces of single-sided materials are culled by both
 //! queries; metallic-roughness surfaces vanish in a white furnace where their BSDF conserves
 //! energy.
 
@@ -78,6 +79,35 @@ fn a_cut_out_texel_is_passed_through_by_both_queries_in_every_structure() {
             let hit = vis.closest_hit(&right, &mut NoCount).expect("the quad");
             assert_eq!((hit.object, hit.t), (quad, 5.0), "{kind}: the right half is there");
             assert!(vis.any_hit(&Ray::segment(right.origin(), -Vec3::Z, 0.0, 5.5), &mut NoCount), "{kind}");
+        }
+    }
+}
+
+#[test]
+fn the_coverage_is_read_in_the_base_colour_texture_set() {
+    // Set 0 maps the whole quad into the cut-out left texel, set 1 into the solid right one.
+    for (set, solid) in [(0, false), (1, true)] {
+        let mut scene = quad_scene([0, 255], AlphaMode::Mask { cutoff: 0.5 });
+        let object = scene.objects.last_mut().unwrap();
+        let Object::Mesh(quad) = &object.object else { unreachable!("the quad is a mesh") };
+        let uvs = quad.uvs().unwrap();
+        let left = uvs.iter().map(|uv| Vec2::new(0.05 + 0.4 * uv.x, uv.y)).collect();
+        let right = uvs.iter().map(|uv| Vec2::new(0.55 + 0.4 * uv.x, uv.y)).collect();
+        let two = TriangleMesh::new(quad.positions().to_vec(), quad.triangles().to_vec())
+            .and_then(|m| m.with_uvs(left))
+            .and_then(|m| m.with_uvs1(right))
+            .unwrap();
+        object.object = Object::Mesh(Arc::new(two));
+        scene.materials.last_mut().unwrap().textures.base_color =
+            Some(TextureRef { uv_set: set, ..TextureRef::new(0) });
+        let quad = scene.objects.len() as u32 - 1;
+        let world = build_world(&scene, AccelKind::BvhWide).unwrap();
+        let vis = Visibility::new(&scene, &world);
+        for x in [-0.6f32, 0.0, 0.7] {
+            let ray = Ray::new(Vec3::new(x, 0.3, 5.0), -Vec3::Z);
+            let hit = vis.closest_hit(&ray, &mut NoCount).expect("the quad or the sphere");
+            assert_eq!(hit.object == quad, solid, "set {set}, x {x}: {hit:?}");
+            assert_eq!(vis.any_hit(&Ray::segment(ray.origin(), -Vec3::Z, 0.0, 5.5), &mut NoCount), solid, "set {set}");
         }
     }
 }

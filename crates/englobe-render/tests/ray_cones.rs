@@ -1,6 +1,7 @@
 //! Ray cones in renders: a checkerboard too far away to resolve renders as its grey mean with
 //! cones and as aliased black and white without; a magnified texture and every untextured scene
-//! render the same bytes with and without cones; the path tracer filters its first hits too.
+//! render the same bytes with and without cones; the path tracer filters its first hits too; a
+//! board mapped by a second texture coordinate set is filtered by that set's footprint.
 
 use std::sync::Arc;
 
@@ -70,6 +71,32 @@ fn a_far_checkerboard_renders_as_its_grey_mean() {
         let spread = point.iter().map(|p| (p.x - 0.5).abs()).fold(0.0f32, f32::max);
         assert!(spread > 0.2, "at {distance}: point samples alias ({spread})");
     }
+}
+
+#[test]
+fn a_board_read_in_the_second_set_is_filtered_by_that_set_footprint() {
+    // Set 1 spreads the far board over the square as before; set 0 squeezes it into the first
+    // white texel (a footprint far under a texel). The base colour reads set 1: the grey mean
+    // with cones, aliasing without. Set 0's coordinates would render white, and set 0's
+    // footprint with set 1's coordinates would alias.
+    let mut scene = checkerboard(80.0, 4096);
+    let object = scene.objects.last_mut().unwrap();
+    let Object::Mesh(quad) = &object.object else { unreachable!("the board is a mesh") };
+    let set1 = quad.uvs().unwrap().to_vec();
+    let set0 = set1.iter().map(|uv| *uv / 8192.0).collect();
+    let two = TriangleMesh::new(quad.positions().to_vec(), quad.triangles().to_vec())
+        .and_then(|m| m.with_uvs(set0))
+        .and_then(|m| m.with_uvs1(set1))
+        .unwrap();
+    object.object = Object::Mesh(Arc::new(two));
+    let material = scene.materials.last_mut().unwrap();
+    material.textures.base_color = Some(TextureRef { uv_set: 1, ..TextureRef::new(0) });
+    let coned = render(&scene, TextureFilter::Cone);
+    let worst = coned.iter().map(|p| (p.x - 0.5).abs().max((p.y - 0.5).abs())).fold(0.0f32, f32::max);
+    assert!(worst < 1e-3, "a pixel {worst} from the mean");
+    let point = render(&scene, TextureFilter::None);
+    let spread = point.iter().map(|p| (p.x - 0.5).abs()).fold(0.0f32, f32::max);
+    assert!(spread > 0.2, "point samples of set 1 alias ({spread})");
 }
 
 #[test]

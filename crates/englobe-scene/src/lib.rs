@@ -24,6 +24,7 @@ pub mod pbrt;
 pub mod pixel_filter;
 pub mod random_triangles;
 pub mod shared_data;
+pub mod tex_coords;
 pub mod texture;
 
 pub use environment::{Environment, EnvironmentMap, Sky};
@@ -46,4 +47,5 @@ pub use parse::{
 pub use parse_mesh::MAX_MESH_INSTANCES;
 pub use pixel_filter::PixelFilter;
 pub use random_triangles::MAX_RANDOM_TRIANGLES;
+pub use tex_coords::TexCoords;
 pub use texture::{ColorSpace, Sampler, Texture, TextureId, Wrap};

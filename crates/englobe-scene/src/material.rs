@@ -107,8 +107,9 @@ impl UvTransform {
 pub struct TextureRef {
     /// Index into [`crate::Scene::textures`].
     pub texture: TextureId,
-    /// Texture coordinate set (glTF's `texCoord`). englobe's meshes hold one set, `0`; loaders
-    /// warn about references to others, which are read with set 0.
+    /// Texture coordinate set (glTF's `texCoord`, or its `KHR_texture_transform`'s): 0 or 1,
+    /// the sets meshes keep. Set 1 is read with set 0 on a mesh without one (the glTF loader
+    /// warns); loaders map the sets englobe does not keep to 0, with a warning.
     pub uv_set: u32,
     /// Applied to the coordinates before sampling.
     pub transform: Option<UvTransform>,
@@ -216,15 +217,22 @@ impl MaterialTextures {
 
     /// True when no slot holds a texture.
     pub fn is_empty(&self) -> bool {
-        // Asked at every hit: the slots are looked at in place rather than listed.
+        self.refs().iter().all(Option::is_none)
+    }
+
+    /// Every slot's reference, in place: what questions asked at every hit look at (no list
+    /// is allocated).
+    pub(crate) fn refs(&self) -> [Option<&TextureRef>; 7] {
         let MaterialTextures { base_color, metallic_roughness, normal, emission, alpha, specular, occlusion } = self;
-        base_color.is_none()
-            && metallic_roughness.is_none()
-            && normal.is_none()
-            && emission.is_none()
-            && alpha.is_none()
-            && specular.is_none()
-            && occlusion.is_none()
+        [
+            base_color.as_ref(),
+            metallic_roughness.as_ref(),
+            normal.as_ref().map(|n| &n.texture),
+            emission.as_ref(),
+            alpha.as_ref().map(|a| &a.texture),
+            specular.as_ref(),
+            occlusion.as_ref().map(|o| &o.texture),
+        ]
     }
 
     /// Every reference with its texture index moved by `offset` (textures of a mesh file

@@ -10,6 +10,9 @@
 //! classic model reads its textures the same way (MTL `map_Kd` scales `diffuse`, `map_Ks`
 //! `specular`, `map_Ke` `emission`, `map_d` the coverage).
 //!
+//! Every texture reads the texture coordinate set its reference names (see
+//! [`crate::tex_coords`]); the coverage tests read the alpha or base colour texture's set.
+//!
 //! A texture that could not be read shows a fallback that makes the fault visible where it is
 //! colour and harmless where it is data: magenta base colour; no emission; factors unchanged for
 //! metalness, roughness, alpha and highlight; the interpolated normal.
@@ -21,6 +24,7 @@ use glam::{Vec2, Vec3, Vec4};
 use crate::material::{
     AlphaMode, Channel, Material, MaterialModel, NormalEncoding, ScalarTexture, TextureRef, shininess_to_roughness,
 };
+use crate::tex_coords::TexCoords;
 use crate::texture::{ColorSpace, Texture, UvFootprint};
 
 /// Base colour shown where a base colour texture could not be read.
@@ -93,16 +97,23 @@ fn channel(v: Vec4, c: Channel) -> f32 {
     }
 }
 
-fn scalar(textures: &[Arc<Texture>], s: &ScalarTexture, uv: Vec2, footprint: Option<UvFootprint>) -> Option<f32> {
-    let v = channel(lookup_over(textures, &s.texture, uv, footprint, ColorSpace::Linear)?, s.channel);
+/// The texture of `r` at the coordinates of its set in `at`; `None` where the point has none.
+fn lookup_at(textures: &[Arc<Texture>], r: &TextureRef, at: &TexCoords, space: ColorSpace) -> Option<Option<Vec4>> {
+    let (uv, footprint) = at.of(r);
+    Some(lookup_over(textures, r, uv?, footprint, space))
+}
+
+fn scalar(textures: &[Arc<Texture>], s: &ScalarTexture, at: &TexCoords) -> Option<f32> {
+    let v = channel(lookup_at(textures, &s.texture, at, ColorSpace::Linear)??, s.channel);
     Some(s.remap.map_or(v, |[base, gain]| base + gain * v))
 }
 
 impl Material {
-    /// The surface parameters at texture coordinate `uv` (set 0, glTF convention; `None` when
-    /// the mesh has none, which leaves the factors alone), reading `textures` (the scene's).
+    /// The surface parameters at texture coordinate `uv` (glTF convention; `None` when the
+    /// mesh has none, which leaves the factors alone), read by every texture whatever its set,
+    /// reading `textures` (the scene's).
     pub fn evaluate(&self, textures: &[Arc<Texture>], uv: Option<Vec2>) -> SurfaceParams {
-        self.evaluate_over(textures, uv, None)
+        self.evaluate_at(textures, &TexCoords::one(uv, None))
     }
 
     /// [`Material::evaluate`] with every texture read over `footprint` around `uv` (a ray
@@ -114,11 +125,14 @@ impl Material {
         uv: Option<Vec2>,
         footprint: Option<UvFootprint>,
     ) -> SurfaceParams {
+        self.evaluate_at(textures, &TexCoords::one(uv, footprint))
+    }
+
+    /// The surface parameters at the point whose coordinates (and footprints) in each texture
+    /// coordinate set are `at`: every texture reads its own set.
+    pub fn evaluate_at(&self, textures: &[Arc<Texture>], at: &TexCoords) -> SurfaceParams {
         let t = &self.textures;
-        let sample = |r: &Option<TextureRef>, space| -> Option<Option<Vec4>> {
-            let (r, uv) = (r.as_ref()?, uv?);
-            Some(lookup_over(textures, r, uv, footprint, space))
-        };
+        let sample = |r: &Option<TextureRef>, space| lookup_at(textures, r.as_ref()?, at, space);
         // Some(None): the slot has a texture that could not be read.
         let base = sample(&t.base_color, ColorSpace::Srgb);
         let base_color = match base {
@@ -153,13 +167,10 @@ impl Material {
                 (0.0, shininess_to_roughness(self.shininess), self.transparency, self.specular)
             }
         };
-        let normal_ts = match (t.normal, uv) {
-            (Some(n), Some(uv)) => self.normal_from_map(textures, &n, uv, footprint),
-            _ => None,
-        };
+        let normal_ts = t.normal.and_then(|n| self.normal_from_map(textures, &n, at));
         SurfaceParams {
             base_color,
-            alpha: self.alpha_at(textures, uv, base, footprint),
+            alpha: self.alpha_at(textures, at, base),
             metallic: metallic.clamp(0.0, 1.0),
             roughness: roughness.clamp(0.0, 1.0),
             transmission: transmission.clamp(0.0, 1.0),
@@ -167,55 +178,42 @@ impl Material {
             emission,
             normal_ts,
             specular,
-            occlusion: match (&t.occlusion, uv) {
-                (Some(o), Some(uv)) => scalar(textures, o, uv, footprint).unwrap_or(1.0).clamp(0.0, 1.0),
-                _ => 1.0,
-            },
+            occlusion: t.occlusion.as_ref().and_then(|o| scalar(textures, o, at)).unwrap_or(1.0).clamp(0.0, 1.0),
         }
     }
 
-    /// The alpha at `uv`: the factor times the alpha texture's value when there is one (MTL),
-    /// else times the base colour texture's alpha (glTF). `base` is the base colour sample when
-    /// the caller already has it; `footprint` is the lookups' (see [`Material::evaluate_over`]).
-    fn alpha_at(
-        &self,
-        textures: &[Arc<Texture>],
-        uv: Option<Vec2>,
-        base: Option<Option<Vec4>>,
-        footprint: Option<UvFootprint>,
-    ) -> f32 {
+    /// The alpha at `at`: the factor times the alpha texture's value when there is one (MTL),
+    /// else times the base colour texture's alpha (glTF), each read in its own set. `base` is
+    /// the base colour sample when the caller already has it.
+    fn alpha_at(&self, textures: &[Arc<Texture>], at: &TexCoords, base: Option<Option<Vec4>>) -> f32 {
         if self.alpha.mode == AlphaMode::Opaque {
             return 1.0;
         }
-        let texture = match (&self.textures.alpha, uv) {
-            (Some(a), Some(uv)) => scalar(textures, a, uv, footprint),
-            (None, Some(uv)) => match base {
-                Some(b) => b.map(|c| c.w),
-                None => self
-                    .textures
-                    .base_color
-                    .as_ref()
-                    .and_then(|r| lookup_over(textures, r, uv, footprint, ColorSpace::Linear))
-                    .map(|c| c.w),
-            },
-            _ => None,
+        let texture = match &self.textures.alpha {
+            Some(a) => scalar(textures, a, at),
+            None => base
+                .or_else(|| lookup_at(textures, self.textures.base_color.as_ref()?, at, ColorSpace::Linear))
+                .flatten()
+                .map(|c| c.w),
         };
         (self.alpha.factor * texture.unwrap_or(1.0)).clamp(0.0, 1.0)
     }
 
-    /// The fraction of the surface present at `uv`: 1 for opaque materials; 0 or 1 for `MASK`
-    /// (against the cutoff); the alpha itself for `BLEND`.
-    pub fn coverage(&self, textures: &[Arc<Texture>], uv: Option<Vec2>) -> f32 {
+    /// The fraction of the surface present at `uv` (one coordinate for every set, or a
+    /// [`TexCoords`]): 1 for opaque materials; 0 or 1 for `MASK` (against the cutoff); the
+    /// alpha itself for `BLEND`.
+    pub fn coverage(&self, textures: &[Arc<Texture>], uv: impl Into<TexCoords>) -> f32 {
+        let at = uv.into();
         match self.alpha.mode {
             AlphaMode::Opaque => 1.0,
             AlphaMode::Mask { cutoff } => {
-                if self.alpha_at(textures, uv, None, None) >= cutoff {
+                if self.alpha_at(textures, &at, None) >= cutoff {
                     1.0
                 } else {
                     0.0
                 }
             }
-            AlphaMode::Blend => self.alpha_at(textures, uv, None, None),
+            AlphaMode::Blend => self.alpha_at(textures, &at, None),
         }
     }
 
@@ -224,12 +222,12 @@ impl Material {
     /// `xi`; a `BLEND` surface with probability `1 - alpha` (stochastic transparency, Enderton,
     /// Sintorn, Shirley and Luebke 2010). For closest-hit and any-hit queries to agree, `xi` must
     /// depend only on the ray and the hit (a hash of them), not on which query asks.
-    pub fn passes_through(&self, textures: &[Arc<Texture>], uv: Option<Vec2>, xi: f32) -> bool {
+    pub fn passes_through(&self, textures: &[Arc<Texture>], uv: impl Into<TexCoords>, xi: f32) -> bool {
         self.alpha.mode != AlphaMode::Opaque && xi >= self.coverage(textures, uv)
     }
 
     /// True where a `MASK` surface is cut out (or a `BLEND` one fully transparent).
-    pub fn is_cut_out(&self, textures: &[Arc<Texture>], uv: Option<Vec2>) -> bool {
+    pub fn is_cut_out(&self, textures: &[Arc<Texture>], uv: impl Into<TexCoords>) -> bool {
         self.alpha.mode != AlphaMode::Opaque && self.coverage(textures, uv) <= 0.0
     }
 
@@ -237,9 +235,10 @@ impl Material {
         &self,
         textures: &[Arc<Texture>],
         n: &crate::material::NormalMap,
-        uv: Vec2,
-        footprint: Option<UvFootprint>,
+        at: &TexCoords,
     ) -> Option<Vec3> {
+        let (uv, footprint) = at.of(&n.texture);
+        let uv = uv?;
         match n.encoding {
             // A filtered normal map averages normals; the average is shorter than one where
             // they disagree, and is normalised like any other.

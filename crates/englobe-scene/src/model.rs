@@ -8,6 +8,7 @@ use englobe::{Object, TriangleMesh, Vec2, Vec3};
 use glam::Vec4;
 
 pub use crate::material::Material;
+use crate::tex_coords::TexCoords;
 use crate::texture::Texture;
 
 /// Name of the material objects get when they name none.
@@ -304,9 +305,10 @@ pub struct SceneObject {
     /// Instances of one mesh share the array.
     pub triangle_materials: Option<Arc<[MaterialId]>>,
     /// For meshes: one tangent per vertex of the mesh (of the instanced mesh for an instance,
-    /// in its own space), shared by instances: `xyz` the unit tangent along increasing `u`, `w`
-    /// the handedness (`±1`), the bitangent being `w * cross(normal, tangent)`, which points
-    /// towards decreasing `v` (the top of the image: glTF 2.0's `TANGENT` convention, and
+    /// in its own space), shared by instances: `xyz` the unit tangent along increasing `u` (of
+    /// the texture coordinate set the triangle's normal map reads), `w` the handedness (`±1`),
+    /// the bitangent being `w * cross(normal, tangent)`, which points towards decreasing `v`
+    /// (the top of the image: glTF 2.0's `TANGENT` convention, and
     /// MikkTSpace's on coordinates with `v` up). Present when the file gives tangents or a
     /// material of the mesh has a normal map (then generated with MikkTSpace).
     pub tangents: Option<Arc<[Vec4]>>,
@@ -339,9 +341,22 @@ impl SceneObject {
     /// down; OBJ and PLY coordinates were flipped when read) at barycentric `(u, v)` of triangle
     /// `prim`, interpolated from the vertices; `None` for shapes and meshes without coordinates.
     pub fn uv(&self, prim: u32, u: f32, v: f32) -> Option<Vec2> {
-        let uvs = self.mesh()?.uvs()?;
+        self.uv_in(0, prim, u, v)
+    }
+
+    /// [`SceneObject::uv`] in texture coordinate set `set` (0 or 1); `None` where the mesh has
+    /// no such set (no fallback here: see [`TexCoords`]).
+    pub fn uv_in(&self, set: u32, prim: u32, u: f32, v: f32) -> Option<Vec2> {
+        let uvs = self.mesh()?.uv_set(set)?;
         let (tri, w) = self.corners(prim, u, v)?;
         Some(uvs[tri[0] as usize] * w[0] + uvs[tri[1] as usize] * w[1] + uvs[tri[2] as usize] * w[2])
+    }
+
+    /// The texture coordinates at barycentric `(u, v)` of triangle `prim` in set 0, and in set 1
+    /// when `set1` asks for it (a material reads it there) and the mesh has it; no footprints.
+    pub fn tex_coords(&self, set1: bool, prim: u32, u: f32, v: f32) -> TexCoords {
+        let second = if set1 { self.uv_in(1, prim, u, v) } else { None };
+        TexCoords { uv: [self.uv(prim, u, v), second], footprint: [None, None] }
     }
 
     /// The tangent at barycentric `(u, v)` of triangle `prim` (see [`SceneObject::tangents`]):

@@ -21,6 +21,8 @@ pub(super) struct MeshParts {
     pub triangles: Vec<[u32; 3]>,
     pub normals: Option<Vec<Vec3>>,
     pub uvs: Option<Vec<Vec2>>,
+    /// The second texture coordinate set (glTF's `TEXCOORD_1`), when a material samples it.
+    pub uvs1: Option<Vec<Vec2>>,
     pub tangents: Option<Vec<Vec4>>,
     /// One per triangle, indexing the materials or [`NO_MATERIAL`].
     pub triangle_materials: Option<Vec<u32>>,
@@ -69,10 +71,14 @@ pub(super) fn finish(
             parts.normals = None;
         }
     }
-    if let Some(uv) = &parts.uvs {
-        if uv.len() != vertices || uv.iter().any(|v| !v.is_finite()) {
-            warnings.push(format!("{} texture coordinates for {vertices} vertices; they are dropped", uv.len()));
-            parts.uvs = None;
+    for (set, uvs) in [&mut parts.uvs, &mut parts.uvs1].into_iter().enumerate() {
+        if let Some(uv) = uvs {
+            if uv.len() != vertices || uv.iter().any(|v| !v.is_finite()) {
+                let which = if set == 0 { String::new() } else { format!(" (set {set})") };
+                warnings
+                    .push(format!("{} texture coordinates{which} for {vertices} vertices; they are dropped", uv.len()));
+                *uvs = None;
+            }
         }
     }
 
@@ -103,6 +109,9 @@ pub(super) fn finish(
     }
     if let Some(uv) = parts.uvs {
         mesh = mesh.with_uvs(uv).map_err(to_err)?;
+    }
+    if let Some(uv) = parts.uvs1 {
+        mesh = mesh.with_uvs1(uv).map_err(to_err)?;
     }
     Ok(LoadedMesh {
         mesh,

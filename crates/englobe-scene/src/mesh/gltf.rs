@@ -3,6 +3,12 @@
 //! of one triangle mesh; materials and their textures are read by [`super::gltf_material`].
 //! Vertex tangents (`TANGENT`) are kept when every primitive has them.
 //!
+//! Texture coordinates: `TEXCOORD_0` is kept when every primitive has it. `TEXCOORD_1` is read
+//! only when a material of the file samples it (a texture's `texCoord: 1`), so that the many files
+//! carrying a second set no material uses (light-map coordinates, mostly) cost nothing; a
+//! primitive without it gets a copy of its `TEXCOORD_0` in its place, which is what reading
+//! set 0 instead means, and a warning names the materials that wanted set 1 there.
+//!
 //! The `gltf` crate parses the JSON into its document model; englobe does the rest: the GLB
 //! container (whose header the crate subtracts from without checking), the required extensions
 //! (a file that needs Draco or meshopt compression is refused, naming the extension), every index
@@ -10,6 +16,7 @@
 //! panics on a bad `POSITION`, so it is not used), a bounded walk over the node hierarchy (cycles
 //! and exponential sharing refused), and every accessor through [`super::gltf_data`].
 
+use std::collections::BTreeMap;
 use std::path::Path;
 
 use englobe::{Vec2, Vec3};
@@ -64,6 +71,12 @@ pub(super) fn load(path: &Path, bytes: &[u8], format: MeshFormat) -> Result<Load
     }
     let mut buffers = Buffers::new(path, &root, bin);
     let read = super::gltf_material::materials(path, &root, &mut buffers);
+    // The slots of each material that sample set 1.
+    let set1_slots: Vec<Vec<&'static str>> = read
+        .materials
+        .iter()
+        .map(|(_, m)| m.textures.slots().into_iter().filter(|(_, r)| r.uv_set == 1).map(|(slot, _)| slot).collect())
+        .collect();
     let mut builder = Builder {
         path,
         root: &root,
@@ -71,6 +84,10 @@ pub(super) fn load(path: &Path, bytes: &[u8], format: MeshFormat) -> Result<Load
         parts: MeshParts::default(),
         normals: Vec::new(),
         uvs: Vec::new(),
+        uvs1: Vec::new(),
+        want_uvs1: set1_slots.iter().any(|s| !s.is_empty()),
+        set1_slots: &set1_slots,
+        lacking_uvs1: BTreeMap::new(),
         tangents: Vec::new(),
         ids: Vec::new(),
         all_normals: true,
@@ -83,16 +100,41 @@ pub(super) fn load(path: &Path, bytes: &[u8], format: MeshFormat) -> Result<Load
             builder.add_mesh(node, mesh.value(), &transform)?;
         }
     }
-    let Builder { mut parts, mut warnings, normals, uvs, tangents, ids, all_normals, all_uvs, all_tangents, .. } =
-        builder;
+    let vertices = builder.parts.positions.len();
+    if !builder.uvs1.is_empty() {
+        builder.pad_uvs1(vertices);
+    }
+    let Builder {
+        mut parts,
+        mut warnings,
+        normals,
+        uvs,
+        uvs1,
+        lacking_uvs1,
+        tangents,
+        ids,
+        all_normals,
+        all_uvs,
+        all_tangents,
+        ..
+    } = builder;
     if parts.positions.is_empty() {
         return Err(MeshFileError::file(path, MeshErrorKind::NoTriangles(" in the default scene".into())));
     }
     if !all_normals && !normals.is_empty() {
         warnings.push("some primitives have no normals; shading uses face normals".into());
     }
+    for (material, (first, count)) in lacking_uvs1 {
+        let slots = set1_slots[material as usize].join(" and ");
+        let more = if count > 1 { format!(" (and {} more primitives)", count - 1) } else { String::new() };
+        warnings.push(format!(
+            "material `{}`: its {slots} texture reads TEXCOORD_1, which {first}{more} has not; TEXCOORD_0 is read there instead",
+            read.materials[material as usize].0
+        ));
+    }
     parts.normals = (all_normals && !normals.is_empty()).then_some(normals);
     parts.uvs = (all_uvs && !uvs.is_empty()).then_some(uvs);
+    parts.uvs1 = (!uvs1.is_empty()).then_some(uvs1);
     parts.tangents = (all_tangents && all_normals && !tangents.is_empty()).then_some(tangents);
     parts.triangle_materials = Some(ids);
     finish(path, format, parts, (read.materials, read.textures), warnings)
@@ -237,6 +279,16 @@ struct Builder<'a> {
     parts: MeshParts,
     normals: Vec<Vec3>,
     uvs: Vec<Vec2>,
+    /// Set 1, from the first primitive that has it on (empty until then, and when no material
+    /// samples it).
+    uvs1: Vec<Vec2>,
+    /// Whether a material samples set 1, and so whether `TEXCOORD_1` is read at all.
+    want_uvs1: bool,
+    /// For each material, the slots that sample set 1.
+    set1_slots: &'a [Vec<&'static str>],
+    /// Materials that sample set 1 on primitives without it: the first such primitive and how
+    /// many there are.
+    lacking_uvs1: BTreeMap<u32, (String, usize)>,
     tangents: Vec<Vec4>,
     ids: Vec<u32>,
     all_normals: bool,
@@ -246,6 +298,36 @@ struct Builder<'a> {
 }
 
 impl Builder<'_> {
+    /// Extends set 1 to `vertices` entries with the vertices' set 0 (`(0, 0)` where they have
+    /// none): those vertices read set 0 wherever set 1 is asked for. `uvs` holds every vertex's
+    /// set 0 from the first up to the first primitive without it, after which it grows no more.
+    fn pad_uvs1(&mut self, vertices: usize) {
+        let from = self.uvs1.len();
+        self.uvs1.extend((from..vertices).map(|i| self.uvs.get(i).copied().unwrap_or(Vec2::ZERO)));
+    }
+
+    /// Texture coordinate set `set` of primitive `at` (accessor `index`), one per vertex of its
+    /// `count`: VEC2 of floats, or of unsigned bytes or shorts normalised to `0..=1` (the only
+    /// types glTF 2.0 allows for `TEXCOORD_n`, section 3.7.2.1; the integers read as such
+    /// without `normalized: true` would be texel-sized steps of a whole image).
+    fn tex_coords(&mut self, index: usize, set: u32, at: &str, count: usize) -> Result<Vec<Vec2>, MeshFileError> {
+        let path = self.path;
+        let what = format!("TEXCOORD_{set}");
+        let kinds = [ComponentType::F32, ComponentType::U8, ComponentType::U16];
+        let acc = self.buffers.accessor(self.root, index, &what, &[Type::Vec2], &kinds)?;
+        if !acc.is_normalized() {
+            return Err(MeshFileError::new(
+                path,
+                Some(Position::Json(format!("accessors[{index}].normalized"))),
+                MeshErrorKind::Malformed(format!(
+                    "{what} of unsigned integers must be normalized (`\"normalized\": true`), as glTF 2.0 requires"
+                )),
+            ));
+        }
+        check_count(path, at, &what, index, acc.count, count)?;
+        Ok(acc.vectors::<2>(path, "a texture coordinate")?.into_iter().map(Vec2::from).collect())
+    }
+
     fn add_mesh(&mut self, node: usize, mesh: usize, transform: &Mat4) -> Result<(), MeshFileError> {
         let (path, root) = (self.path, self.root);
         let normal_matrix = Mat3::from_mat4(*transform).inverse().transpose();
@@ -284,7 +366,7 @@ impl Builder<'_> {
             match normal {
                 Some(n) if self.all_normals => {
                     let acc = self.buffers.accessor(root, n.value(), "NORMAL", &[Type::Vec3], &f32_only)?;
-                    check_count(path, &at, "NORMAL", acc.count, count)?;
+                    check_count(path, &at, "NORMAL", n.value(), acc.count, count)?;
                     let normals = acc.vectors::<3>(path, "a normal")?;
                     self.normals.extend(normals.iter().map(|n| (normal_matrix * Vec3::from(*n)).normalize_or_zero()));
                 }
@@ -293,7 +375,7 @@ impl Builder<'_> {
             match prim.attributes.get(&Checked::Valid(Semantic::Tangents)) {
                 Some(t) if self.all_tangents => {
                     let acc = self.buffers.accessor(root, t.value(), "TANGENT", &[Type::Vec4], &f32_only)?;
-                    check_count(path, &at, "TANGENT", acc.count, count)?;
+                    check_count(path, &at, "TANGENT", t.value(), acc.count, count)?;
                     // Tangents move with the surface (not the inverse transpose); a mirroring
                     // transform flips the bitangent, so the handedness flips with it.
                     let linear = Mat3::from_mat4(*transform);
@@ -305,14 +387,37 @@ impl Builder<'_> {
                 }
                 _ => self.all_tangents = false,
             }
+            let material = prim.material.map_or(NO_MATERIAL, |m| m.value() as u32);
+            if material != NO_MATERIAL && material as usize >= root.materials.len() {
+                return Err(MeshFileError::new(
+                    path,
+                    Some(Position::Json(format!("{at}.material"))),
+                    MeshErrorKind::Malformed("refers to a missing material".into()),
+                ));
+            }
             match prim.attributes.get(&Checked::Valid(Semantic::TexCoords(0))) {
                 Some(t) if self.all_uvs => {
-                    let kinds = [ComponentType::F32, ComponentType::U8, ComponentType::U16];
-                    let acc = self.buffers.accessor(root, t.value(), "TEXCOORD_0", &[Type::Vec2], &kinds)?;
-                    check_count(path, &at, "TEXCOORD_0", acc.count, count)?;
-                    self.uvs.extend(acc.vectors::<2>(path, "a texture coordinate")?.into_iter().map(Vec2::from));
+                    let uvs = self.tex_coords(t.value(), 0, &at, count)?;
+                    self.uvs.extend(uvs);
                 }
                 _ => self.all_uvs = false,
+            }
+            if self.want_uvs1 {
+                match prim.attributes.get(&Checked::Valid(Semantic::TexCoords(1))) {
+                    Some(t) => {
+                        let uvs = self.tex_coords(t.value(), 1, &at, count)?;
+                        self.pad_uvs1(base);
+                        self.uvs1.extend(uvs);
+                    }
+                    None => {
+                        if self.set1_slots.get(material as usize).is_some_and(|s| !s.is_empty()) {
+                            self.lacking_uvs1.entry(material).or_insert_with(|| (at.clone(), 0)).1 += 1;
+                        }
+                        if !self.uvs1.is_empty() {
+                            self.pad_uvs1(base + count);
+                        }
+                    }
+                }
             }
 
             let indices: Vec<u32> = match prim.indices {
@@ -369,28 +474,21 @@ impl Builder<'_> {
                     MeshErrorKind::Malformed(format!("the scene expands to more than {MAX_TRIANGLES} triangles")),
                 ));
             }
-            let material = prim.material.map_or(NO_MATERIAL, |m| m.value() as u32);
-            if material != NO_MATERIAL && material as usize >= root.materials.len() {
-                return Err(MeshFileError::new(
-                    path,
-                    Some(Position::Json(format!("{at}.material"))),
-                    MeshErrorKind::Malformed("refers to a missing material".into()),
-                ));
-            }
             self.ids.resize(self.ids.len() + tris.len() - before, material);
         }
         Ok(())
     }
 }
 
-/// Refuses an attribute whose count differs from the positions'.
-fn check_count(path: &Path, at: &str, what: &str, got: usize, want: usize) -> Result<(), MeshFileError> {
+/// Refuses attribute `what` of primitive `at`, accessor `index`, when its count differs from the
+/// positions'.
+fn check_count(path: &Path, at: &str, what: &str, index: usize, got: usize, want: usize) -> Result<(), MeshFileError> {
     if got == want {
         return Ok(());
     }
     Err(MeshFileError::new(
         path,
-        Some(Position::Json(at.to_owned())),
-        MeshErrorKind::Malformed(format!("{what} has {got} elements but POSITION has {want}")),
+        Some(Position::Json(format!("{at}.attributes.{what}"))),
+        MeshErrorKind::Malformed(format!("accessors[{index}] has {got} elements but POSITION has {want}")),
     ))
 }

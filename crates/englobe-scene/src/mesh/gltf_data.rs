@@ -245,6 +245,12 @@ impl<'a> Buffers<'a> {
 }
 
 impl Accessor<'_> {
+    /// Whether integer components are read as normalised (`normalized: true`); always true of
+    /// floats, which have nothing to normalise.
+    pub(super) fn is_normalized(&self) -> bool {
+        self.component == ComponentType::F32 || self.normalized
+    }
+
     /// Component `c` of element `k` as a float (normalised integers mapped to 0..=1).
     #[inline]
     pub(super) fn float(&self, k: usize, c: usize) -> f32 {

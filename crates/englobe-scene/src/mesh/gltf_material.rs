@@ -4,7 +4,8 @@
 //! `alphaMode` and `alphaCutoff`, `doubleSided`, `KHR_materials_transmission` and
 //! `KHR_materials_ior`, and `KHR_texture_transform` on the textures that carry it (the `gltf`
 //! crate keeps it on all but the normal and occlusion textures). The occlusion texture is kept
-//! for ambient terms (a path tracer computes the occlusion it approximates).
+//! for ambient terms (a path tracer computes the occlusion it approximates). Each texture keeps
+//! its `texCoord` (or the transform's), set 0 or 1; higher sets are read with set 0.
 //!
 //! Images come from files beside the `.gltf` (URIs relative to it, percent-decoded), `data:`
 //! URIs, or buffer views (the GLB binary chunk). Each glTF texture becomes one
@@ -150,11 +151,16 @@ impl Reader<'_, '_> {
             ));
             return None;
         };
-        if set != 0 {
+        // Meshes keep sets 0 and 1 (see `super::gltf`); a texture asking for another is read
+        // with set 0, and its reference says so.
+        let set = if set > 1 {
             self.out.warnings.push(format!(
-                "material `{material}`: the {slot} texture uses TEXCOORD_{set}; englobe keeps TEXCOORD_0 only and samples it with that"
+                "material `{material}`: the {slot} texture uses TEXCOORD_{set}; englobe reads TEXCOORD_0 and TEXCOORD_1 only and samples it with TEXCOORD_0"
             ));
-        }
+            0
+        } else {
+            set
+        };
         let t = &self.out.textures[texture as usize];
         if let Some(e) = &t.error {
             self.out.warnings.push(format!(

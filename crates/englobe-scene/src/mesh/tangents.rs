@@ -7,14 +7,27 @@
 //! the top of the image, which is what a normal map's green channel means. The algorithm writes
 //! one tangent per triangle corner; corners sharing a vertex share its position, normal and
 //! coordinates and so get the same tangent, which is kept per vertex.
+//!
+//! glTF ties tangents to the normal texture's coordinates (section 3.7.2.1), and a normal texture
+//! may read the second set (`texCoord: 1`): each triangle is given the coordinates of the set its
+//! own normal map reads. Triangles of different materials share no vertex in a glTF file (each
+//! primitive has its own), so no vertex mixes the two sets.
 
 use englobe::{Vec2, Vec3};
 use glam::Vec4;
 
+/// The texture coordinates tangents follow: sets 0 and 1 as the mesh has them, and the set each
+/// triangle's normal map reads (a set the mesh lacks gives `(0, 0)`, a degenerate mapping whose
+/// tangents are never used: without coordinates no normal map is read there).
+pub(super) struct TangentUvs<'a> {
+    pub sets: [Option<&'a [Vec2]>; 2],
+    pub set_of_face: &'a dyn Fn(usize) -> usize,
+}
+
 struct Geometry<'a> {
     positions: &'a [Vec3],
     normals: Option<&'a [Vec3]>,
-    uvs: &'a [Vec2],
+    uvs: TangentUvs<'a>,
     triangles: &'a [[u32; 3]],
     sum: Vec<Vec3>,
     sign: Vec<f32>,
@@ -50,7 +63,8 @@ impl mikktspace::Geometry for Geometry<'_> {
     }
 
     fn tex_coord(&self, face: usize, vert: usize) -> [f32; 2] {
-        let uv = self.uvs[self.vertex(face, vert)];
+        let set = (self.uvs.set_of_face)(face).min(1);
+        let uv = self.uvs.sets[set].map_or(Vec2::ZERO, |uvs| uvs[self.vertex(face, vert)]);
         [uv.x, 1.0 - uv.y]
     }
 
@@ -68,7 +82,7 @@ impl mikktspace::Geometry for Geometry<'_> {
 pub(super) fn generate_tangents(
     positions: &[Vec3],
     normals: Option<&[Vec3]>,
-    uvs: &[Vec2],
+    uvs: TangentUvs,
     triangles: &[[u32; 3]],
 ) -> Option<Vec<Vec4>> {
     let n = positions.len();
@@ -99,13 +113,18 @@ pub(super) fn generate_tangents(
 mod tests {
     use super::*;
 
+    /// Set 0 only.
+    fn set0(uvs: &[Vec2]) -> TangentUvs<'_> {
+        TangentUvs { sets: [Some(uvs), None], set_of_face: &|_| 0 }
+    }
+
     #[test]
     fn a_quad_mapped_upright_has_tangent_x_and_bitangent_up() {
         // The xy square facing +z, the image upright on it: u along +x, v (down the image) along -y.
         let positions = [Vec3::ZERO, Vec3::X, Vec3::new(1.0, 1.0, 0.0), Vec3::Y];
         let uvs = [Vec2::new(0.0, 1.0), Vec2::new(1.0, 1.0), Vec2::new(1.0, 0.0), Vec2::new(0.0, 0.0)];
         let normals = [Vec3::Z; 4];
-        let t = generate_tangents(&positions, Some(&normals), &uvs, &[[0, 1, 2], [0, 2, 3]]).unwrap();
+        let t = generate_tangents(&positions, Some(&normals), set0(&uvs), &[[0, 1, 2], [0, 2, 3]]).unwrap();
         for tangent in &t {
             assert!((tangent.truncate() - Vec3::X).length() < 1e-5, "{tangent}");
             // The bitangent w * cross(n, t) = +y: towards the top of the image.
@@ -114,11 +133,29 @@ mod tests {
         // Mirrored along u (u along -x): the tangent turns and the handedness flips, so the
         // bitangent still points up the image.
         let mirrored: Vec<Vec2> = uvs.iter().map(|uv| Vec2::new(1.0 - uv.x, uv.y)).collect();
-        let t = generate_tangents(&positions, Some(&normals), &mirrored, &[[0, 1, 2], [0, 2, 3]]).unwrap();
+        let t = generate_tangents(&positions, Some(&normals), set0(&mirrored), &[[0, 1, 2], [0, 2, 3]]).unwrap();
         for tangent in &t {
             assert!((tangent.truncate() + Vec3::X).length() < 1e-5, "{tangent}");
             let bitangent = tangent.w * Vec3::Z.cross(tangent.truncate());
             assert!((bitangent - Vec3::Y).length() < 1e-5, "{bitangent}");
+        }
+    }
+
+    #[test]
+    fn each_triangle_follows_the_set_its_normal_map_reads() {
+        // Two separate triangles facing +z; set 0 runs u along +x on both, set 1 along +y. The
+        // second triangle's normal map reads set 1: its tangent turns to +y.
+        let positions = [Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::ZERO, Vec3::X, Vec3::Y];
+        let normals = [Vec3::Z; 6];
+        let uv0: Vec<Vec2> = positions.iter().map(|p| Vec2::new(p.x, 1.0 - p.y)).collect();
+        let uv1: Vec<Vec2> = positions.iter().map(|p| Vec2::new(p.y, p.x)).collect();
+        let uvs = TangentUvs { sets: [Some(&uv0), Some(&uv1)], set_of_face: &|face| face };
+        let t = generate_tangents(&positions, Some(&normals), uvs, &[[0, 1, 2], [3, 4, 5]]).unwrap();
+        for tangent in &t[..3] {
+            assert!((tangent.truncate() - Vec3::X).length() < 1e-5, "{tangent}");
+        }
+        for tangent in &t[3..] {
+            assert!((tangent.truncate() - Vec3::Y).length() < 1e-5, "{tangent}");
         }
     }
 }

@@ -14,7 +14,7 @@ pub fn transform_tangents(tangents: &[Vec4], m: &Affine3A) -> Vec<Vec4> {
         .collect()
 }
 
-/// The mesh with `m` applied to its vertices and normals. Refuses transforms that are singular or
+/// The mesh with `m` applied to its vertices and normals (texture coordinates copied as they are). Refuses transforms that are singular or
 /// that carry a vertex beyond what `f32` holds.
 pub fn bake_transform(mesh: &TriangleMesh, m: &Affine3A) -> Result<TriangleMesh, String> {
     let det = m.matrix3.determinant();
@@ -35,6 +35,9 @@ pub fn bake_transform(mesh: &TriangleMesh, m: &Affine3A) -> Result<TriangleMesh,
     }
     if let Some(uvs) = mesh.uvs() {
         out = out.with_uvs(uvs.to_vec()).map_err(|e| e.to_string())?;
+    }
+    if let Some(uvs) = mesh.uvs1() {
+        out = out.with_uvs1(uvs.to_vec()).map_err(|e| e.to_string())?;
     }
     Ok(out)
 }

@@ -92,20 +92,24 @@ pub fn check_arrays(vertices: &[[f32; 3]], triangles: &[[u32; 3]]) -> Result<(),
 }
 
 /// An indexed triangle mesh with optional per-vertex normals (for smooth shading) and texture
-/// coordinates. Construction checks every index and coordinate, so queries never can fail.
+/// coordinates: a first set, and a second one for files that map some textures differently
+/// (glTF's `TEXCOORD_1`, often a light map's or a decal's). Construction checks every index and
+/// coordinate, so queries never can fail.
 #[derive(Clone, Debug, PartialEq)]
 pub struct TriangleMesh {
     positions: Vec<Vec3>,
     triangles: Vec<[u32; 3]>,
     normals: Option<Vec<Vec3>>,
     uvs: Option<Vec<Vec2>>,
+    /// The second set: `None` unless a loader keeps one, so that meshes with one set pay nothing.
+    uvs1: Option<Vec<Vec2>>,
 }
 
 impl TriangleMesh {
     /// A mesh from vertex positions and triangles (vertex indices, counter-clockwise).
     pub fn new(positions: Vec<Vec3>, triangles: Vec<[u32; 3]>) -> Result<Self, MeshError> {
         check_mesh(&positions, &triangles)?;
-        Ok(TriangleMesh { positions, triangles, normals: None, uvs: None })
+        Ok(TriangleMesh { positions, triangles, normals: None, uvs: None, uvs1: None })
     }
 
     /// A mesh from plain arrays: vertex positions as `[x, y, z]` and triangles as three vertex
@@ -129,6 +133,7 @@ impl TriangleMesh {
             triangles: triangles.to_vec(),
             normals: None,
             uvs: None,
+            uvs1: None,
         })
     }
 
@@ -170,6 +175,20 @@ impl TriangleMesh {
         Ok(self)
     }
 
+    /// Adds a second set of per-vertex texture coordinates (set 1; [`TriangleMesh::with_uvs`]
+    /// gives set 0).
+    pub fn with_uvs1(mut self, uvs: Vec<Vec2>) -> Result<Self, MeshError> {
+        if uvs.len() != self.positions.len() {
+            return Err(MeshError::AttributeCount {
+                attribute: "uvs (set 1)",
+                got: uvs.len(),
+                vertices: self.positions.len(),
+            });
+        }
+        self.uvs1 = Some(uvs);
+        Ok(self)
+    }
+
     /// Vertex positions.
     pub fn positions(&self) -> &[Vec3] {
         &self.positions
@@ -185,9 +204,23 @@ impl TriangleMesh {
         self.normals.as_deref()
     }
 
-    /// Per-vertex texture coordinates, if any.
+    /// Per-vertex texture coordinates (set 0), if any.
     pub fn uvs(&self) -> Option<&[Vec2]> {
         self.uvs.as_deref()
+    }
+
+    /// The second set of per-vertex texture coordinates, if any.
+    pub fn uvs1(&self) -> Option<&[Vec2]> {
+        self.uvs1.as_deref()
+    }
+
+    /// Texture coordinate set `set` (0 or 1), if the mesh has it; `None` for any other set.
+    pub fn uv_set(&self, set: u32) -> Option<&[Vec2]> {
+        match set {
+            0 => self.uvs(),
+            1 => self.uvs1(),
+            _ => None,
+        }
     }
 
     /// Number of triangles.
@@ -264,6 +297,17 @@ mod tests {
         let e = TriangleMesh::new(vec![Vec3::ZERO, Vec3::new(f32::NAN, 0.0, 0.0)], vec![]).unwrap_err();
         assert!(matches!(e, MeshError::NonFiniteVertex { vertex: 1, .. }), "{e}");
         assert!(quad().with_normals(vec![Vec3::Z]).is_err());
+        assert!(quad().with_uvs1(vec![Vec2::ZERO; 3]).is_err());
+    }
+
+    #[test]
+    fn two_texture_coordinate_sets() {
+        let m = quad();
+        assert!(m.uv_set(0).is_none() && m.uv_set(1).is_none());
+        let m = m.with_uvs(vec![Vec2::ZERO; 4]).unwrap().with_uvs1(vec![Vec2::ONE; 4]).unwrap();
+        assert_eq!(m.uv_set(0), Some(&[Vec2::ZERO; 4][..]));
+        assert_eq!(m.uv_set(1), Some(&[Vec2::ONE; 4][..]));
+        assert_eq!(m.uv_set(2), None);
     }
 
     #[test]
