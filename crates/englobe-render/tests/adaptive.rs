@@ -9,7 +9,7 @@ use englobe::AccelKind;
 use englobe_render::adaptive::BLOCK_SIZE;
 use englobe_render::supersample::AdaptiveSupersampling;
 use englobe_render::{DEFAULT_SCENE, Film, PixelWindow, RayKind, RenderOutput, Renderer, build_world};
-use englobe_scene::{IntegratorKind, Scene, parse_scene};
+use englobe_scene::{IntegratorKind, NoiseAllocation, Scene, parse_scene};
 
 /// The default scene path traced, small: sky (flat) around noisy diffuse spheres.
 fn scene(threshold: f32) -> Scene {
@@ -81,14 +81,33 @@ fn every_pixel_is_the_uniform_render_of_its_own_sample_count() {
 
 #[test]
 fn the_same_bytes_on_one_thread_or_many() {
-    let s = scene(0.03);
-    let one = render_on(&s, 1, None);
-    for threads in [2, 3] {
-        let many = render_on(&s, threads, None);
-        assert_eq!(bits(&one.film), bits(&many.film), "{threads} threads");
-        assert_eq!(one.samples_map, many.samples_map);
-        assert_eq!(one.stats, many.stats);
+    for allocation in [NoiseAllocation::Even, NoiseAllocation::Mse] {
+        let mut s = scene(0.03);
+        s.image.noise_allocation = allocation;
+        let one = render_on(&s, 1, None);
+        for threads in [2, 3] {
+            let many = render_on(&s, threads, None);
+            assert_eq!(bits(&one.film), bits(&many.film), "{allocation:?}, {threads} threads");
+            assert_eq!(one.samples_map, many.samples_map);
+            assert_eq!(one.stats, many.stats);
+        }
     }
+}
+
+#[test]
+fn the_mse_allocation_takes_fewer_samples_where_noise_is_high() {
+    // The same threshold: equal at the first pass, so the sky's blocks stop alike; where noise
+    // keeps blocks sampling, mse relaxes the threshold as they go and takes fewer samples.
+    let even = render_on(&scene(0.02), 1, None);
+    let mut s = scene(0.02);
+    s.image.noise_allocation = NoiseAllocation::Mse;
+    let mse = render_on(&s, 1, None);
+    let (e, m) = (even.samples_map.unwrap(), mse.samples_map.unwrap());
+    let (e, m) = (e.values(), m.values());
+    assert_eq!(e.len(), m.len());
+    assert!(e.iter().zip(m).all(|(a, b)| b <= a), "no block takes more with mse");
+    assert!(m.iter().sum::<u64>() < e.iter().sum::<u64>());
+    assert_eq!(e.iter().min(), m.iter().min(), "the first pass is the same");
 }
 
 #[test]
