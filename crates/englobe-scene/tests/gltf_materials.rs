@@ -2,36 +2,16 @@
 //! and GLB buffer views), and on the DamagedHelmet sample: factors, textures in their slots,
 //! samplers, alpha, extensions, tangents, and the warnings of what cannot be read.
 
-use std::path::{Path, PathBuf};
+mod common;
 
+use std::path::Path;
+
+use common::{base64, png, write};
 use englobe::{Vec2, Vec3};
 use englobe_scene::mesh::{LoadedMesh, load_mesh_file};
 use englobe_scene::shared_data::shared_meshes_or_panic;
 use englobe_scene::{AlphaMode, MISSING_TEXTURE_COLOR, MaterialModel, NormalEncoding, Wrap, load_scene};
 use serde_json::json;
-
-fn base64(bytes: &[u8]) -> String {
-    const A: &[u8] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    let mut out = String::new();
-    for c in bytes.chunks(3) {
-        let n = (c[0] as u32) << 16 | (*c.get(1).unwrap_or(&0) as u32) << 8 | *c.get(2).unwrap_or(&0) as u32;
-        for k in 0..4 {
-            if k <= c.len() {
-                out.push(A[(n >> (18 - 6 * k) & 63) as usize] as char);
-            } else {
-                out.push('=');
-            }
-        }
-    }
-    out
-}
-
-fn png(w: u32, h: u32, texels: &[[u8; 4]]) -> Vec<u8> {
-    let img = image::RgbaImage::from_raw(w, h, texels.iter().flatten().copied().collect()).unwrap();
-    let mut out = std::io::Cursor::new(Vec::new());
-    img.write_to(&mut out, image::ImageFormat::Png).unwrap();
-    out.into_inner()
-}
 
 /// A unit quad in the xy plane facing +z: positions, normals, texture coordinates (the image
 /// upright: u along +x, v down along -y) and indices.
@@ -69,12 +49,6 @@ fn quad_doc(buffer_uri: Option<String>, buffer_len: usize) -> serde_json::Value 
             {"bufferView": 3, "componentType": 5123, "count": 6, "type": "SCALAR"}
         ]
     })
-}
-
-fn write(dir: &Path, name: &str, bytes: &[u8]) -> PathBuf {
-    let p = dir.join(name);
-    std::fs::write(&p, bytes).unwrap();
-    p
 }
 
 /// The quad with a material using a texture file beside it (base colour), a data URI

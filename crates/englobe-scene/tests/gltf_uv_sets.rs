@@ -4,37 +4,15 @@
 //! sets a mesh lacks fall back to set 0 with a warning; a malformed `TEXCOORD_1` is refused with
 //! the file, the primitive and the accessor named.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 
+use common::{base64, png, write};
 use englobe::Vec3;
 use englobe_scene::mesh::{LoadedMesh, MeshFileError, load_mesh_file};
 use englobe_scene::{Scene, SceneObject, TexCoords, load_scene};
 use serde_json::{Value, json};
-
-fn base64(bytes: &[u8]) -> String {
-    const A: &[u8] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    let mut out = String::new();
-    for c in bytes.chunks(3) {
-        let n = (c[0] as u32) << 16 | (*c.get(1).unwrap_or(&0) as u32) << 8 | *c.get(2).unwrap_or(&0) as u32;
-        for k in 0..4 {
-            out.push(if k <= c.len() { A[(n >> (18 - 6 * k) & 63) as usize] as char } else { '=' });
-        }
-    }
-    out
-}
-
-fn png(w: u32, h: u32, texels: &[[u8; 4]]) -> Vec<u8> {
-    let img = image::RgbaImage::from_raw(w, h, texels.iter().flatten().copied().collect()).unwrap();
-    let mut out = std::io::Cursor::new(Vec::new());
-    img.write_to(&mut out, image::ImageFormat::Png).unwrap();
-    out.into_inner()
-}
-
-fn write(dir: &Path, name: &str, bytes: &[u8]) -> PathBuf {
-    let p = dir.join(name);
-    std::fs::write(&p, bytes).unwrap();
-    p
-}
 
 const FLOAT: u32 = 5126;
 const UNSIGNED_BYTE: u32 = 5121;
