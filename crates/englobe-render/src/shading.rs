@@ -40,8 +40,8 @@ pub struct Surface<'a> {
 
 impl<'a> Surface<'a> {
     /// The surface at `hit` of `ray`: the material's textures read at the hit's texture
-    /// coordinates (each in the set it names), the shading normal bent by its normal map (in the frame of the mesh's tangents,
-    /// moved into the world by an instance's transform).
+    /// coordinates (each in the set it names), the shading normal bent by its normal map (in the
+    /// frame of the mesh's tangents, moved into the world by an instance's transform).
     pub fn at(scene: &'a Scene, world: &World, ray: &Ray, hit: &WorldHit) -> Self {
         Self::at_over(scene, world, ray, hit, None)
     }

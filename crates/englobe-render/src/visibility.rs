@@ -58,10 +58,12 @@ impl<'a> Visibility<'a> {
         if m.culls_back_faces() && self.is_back_face(ray, hit) {
             return false;
         }
+        if !m.has_cutouts() {
+            return true;
+        }
         // The coverage is read in the set of the texture that holds it (the base colour's in glTF).
         let set1 = m.textures.coverage_set() == 1;
-        !m.has_cutouts()
-            || !m.passes_through(&self.scene.textures, object.tex_coords(set1, hit.prim, hit.u, hit.v), hit_number(hit))
+        !m.passes_through(&self.scene.textures, object.tex_coords(set1, hit.prim, hit.u, hit.v), hit_number(hit))
     }
 
     /// True when `ray` meets the triangle of `hit` from behind. Other shapes have no back face

@@ -217,11 +217,18 @@ impl MaterialTextures {
 
     /// True when no slot holds a texture.
     pub fn is_empty(&self) -> bool {
-        self.refs().iter().all(Option::is_none)
+        // Asked at every hit: the slots are looked at in place rather than listed.
+        let MaterialTextures { base_color, metallic_roughness, normal, emission, alpha, specular, occlusion } = self;
+        base_color.is_none()
+            && metallic_roughness.is_none()
+            && normal.is_none()
+            && emission.is_none()
+            && alpha.is_none()
+            && specular.is_none()
+            && occlusion.is_none()
     }
 
-    /// Every slot's reference, in place: what questions asked at every hit look at (no list
-    /// is allocated).
+    /// Every slot's reference, without a list allocated.
     pub(crate) fn refs(&self) -> [Option<&TextureRef>; 7] {
         let MaterialTextures { base_color, metallic_roughness, normal, emission, alpha, specular, occlusion } = self;
         [

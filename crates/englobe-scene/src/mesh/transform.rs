@@ -14,8 +14,8 @@ pub fn transform_tangents(tangents: &[Vec4], m: &Affine3A) -> Vec<Vec4> {
         .collect()
 }
 
-/// The mesh with `m` applied to its vertices and normals (texture coordinates copied as they are). Refuses transforms that are singular or
-/// that carry a vertex beyond what `f32` holds.
+/// The mesh with `m` applied to its vertices and normals (texture coordinates copied as they
+/// are). Refuses transforms that are singular or that carry a vertex beyond what `f32` holds.
 pub fn bake_transform(mesh: &TriangleMesh, m: &Affine3A) -> Result<TriangleMesh, String> {
     let det = m.matrix3.determinant();
     let inverse = m.inverse();

@@ -155,22 +155,14 @@ impl TriangleMesh {
 
     /// Adds per-vertex normals (one per vertex; normalised when used).
     pub fn with_normals(mut self, normals: Vec<Vec3>) -> Result<Self, MeshError> {
-        if normals.len() != self.positions.len() {
-            return Err(MeshError::AttributeCount {
-                attribute: "normals",
-                got: normals.len(),
-                vertices: self.positions.len(),
-            });
-        }
+        self.check_per_vertex("normals", normals.len())?;
         self.normals = Some(normals);
         Ok(self)
     }
 
     /// Adds per-vertex texture coordinates.
     pub fn with_uvs(mut self, uvs: Vec<Vec2>) -> Result<Self, MeshError> {
-        if uvs.len() != self.positions.len() {
-            return Err(MeshError::AttributeCount { attribute: "uvs", got: uvs.len(), vertices: self.positions.len() });
-        }
+        self.check_per_vertex("uvs", uvs.len())?;
         self.uvs = Some(uvs);
         Ok(self)
     }
@@ -178,15 +170,17 @@ impl TriangleMesh {
     /// Adds a second set of per-vertex texture coordinates (set 1; [`TriangleMesh::with_uvs`]
     /// gives set 0).
     pub fn with_uvs1(mut self, uvs: Vec<Vec2>) -> Result<Self, MeshError> {
-        if uvs.len() != self.positions.len() {
-            return Err(MeshError::AttributeCount {
-                attribute: "uvs (set 1)",
-                got: uvs.len(),
-                vertices: self.positions.len(),
-            });
-        }
+        self.check_per_vertex("uvs (set 1)", uvs.len())?;
         self.uvs1 = Some(uvs);
         Ok(self)
+    }
+
+    /// Refuses a per-vertex `attribute` of `got` values that is not one per vertex.
+    fn check_per_vertex(&self, attribute: &'static str, got: usize) -> Result<(), MeshError> {
+        if got == self.positions.len() {
+            return Ok(());
+        }
+        Err(MeshError::AttributeCount { attribute, got, vertices: self.positions.len() })
     }
 
     /// Vertex positions.
