@@ -19,6 +19,8 @@ pub enum LibraryKind {
     EmbreePacket16,
     /// englobe's structure under test.
     Englobe,
+    /// englobe's triangle BVH, 16-ray packets (`TriangleBvh::closest_hit_packet`).
+    EnglobePacket16,
     /// obvhs 0.4, compressed wide BVH (CwBvh).
     Obvhs,
     /// bvh 0.13 (svenstaro/bvh).
@@ -27,8 +29,14 @@ pub enum LibraryKind {
 
 impl LibraryKind {
     /// Every library, in table order.
-    pub const ALL: [LibraryKind; 5] =
-        [LibraryKind::Embree, LibraryKind::EmbreePacket16, LibraryKind::Englobe, LibraryKind::Obvhs, LibraryKind::Bvh];
+    pub const ALL: [LibraryKind; 6] = [
+        LibraryKind::Embree,
+        LibraryKind::EmbreePacket16,
+        LibraryKind::Englobe,
+        LibraryKind::EnglobePacket16,
+        LibraryKind::Obvhs,
+        LibraryKind::Bvh,
+    ];
 
     /// The name in tables and the CSV.
     pub fn name(self) -> &'static str {
@@ -36,6 +44,7 @@ impl LibraryKind {
             LibraryKind::Embree => "embree",
             LibraryKind::EmbreePacket16 => "embree-packet16",
             LibraryKind::Englobe => "englobe",
+            LibraryKind::EnglobePacket16 => "englobe-packet16",
             LibraryKind::Obvhs => "obvhs",
             LibraryKind::Bvh => "bvh",
         }
@@ -92,6 +101,9 @@ pub fn build_library(
 ) -> anyhow::Result<Box<dyn Library>> {
     Ok(match kind {
         LibraryKind::Englobe => Box::new(adapters::englobe::EnglobeLibrary::build(scene, settings.englobe)?),
+        LibraryKind::EnglobePacket16 => {
+            Box::new(adapters::englobe::EnglobeLibrary::build_packets(scene, settings.englobe)?)
+        }
         LibraryKind::Obvhs => Box::new(adapters::obvhs::ObvhsLibrary::build(scene)),
         LibraryKind::Bvh => Box::new(adapters::bvh::BvhLibrary::build(scene)),
         #[cfg(feature = "embree")]

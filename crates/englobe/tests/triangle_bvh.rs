@@ -1,7 +1,7 @@
 //! [`TriangleBvh`], the triangle fast path, against brute force with the scalar watertight test
 //! (Woop, Benthin and Wald 2013): the same closest hit (triangle, `t`, barycentrics, bit for bit)
 //! and the same any-hit answer, in every instruction set the processor has, with counting on and
-//! off. Random soups with degenerate triangles, axis-parallel rays through shared vertices and
+//! off, one ray at a time and in packets. Random soups with degenerate triangles, axis-parallel rays through shared vertices and
 //! edges, ties between copies, deep trees, and the Stanford bunny.
 
 mod common;
@@ -50,6 +50,18 @@ fn check(tris: &[[Vec3; 3]], rays: &[Ray]) -> Result<usize, String> {
             let got_any = bvh.any_hit(ray, &mut NoCount);
             if got_any != any {
                 return Err(format!("{isa}: any hit of {ray:?}: brute force {any}, TriangleBvh {got_any}"));
+            }
+        }
+        // The same rays in packets of sixteen consecutive ones.
+        let mut hits = vec![None; rays.len()];
+        let mut mask = vec![false; rays.len()];
+        bvh.closest_hit_packet(rays, &mut hits, &mut NoCount).map_err(|e| e.to_string())?;
+        bvh.any_hit_packet(rays, &mut mask, &mut NoCount).map_err(|e| e.to_string())?;
+        for ((ray, &(closest, any)), (got, got_any)) in rays.iter().zip(&expected).zip(hits.iter().zip(&mask)) {
+            if *got != closest || *got_any != any {
+                return Err(format!(
+                    "{isa}: packet of {ray:?}: brute force {closest:?} {any}, TriangleBvh {got:?} {got_any}"
+                ));
             }
         }
     }

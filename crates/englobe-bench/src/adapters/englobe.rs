@@ -11,7 +11,8 @@
 use std::fmt;
 
 use englobe::accel::wide::Isa;
-use englobe::{AccelKind, NoCount, Object, TriangleBvh, World};
+use englobe::accel::wide::packet_kernels::PACKET;
+use englobe::{AccelKind, NoCount, Object, Ray, TriangleBvh, Vec3, World};
 
 use crate::library::{BenchRay, Library, RayResult};
 use crate::scene::BenchScene;
@@ -89,6 +90,8 @@ impl fmt::Display for EnglobeStructure {
 pub struct EnglobeLibrary {
     structure: EnglobeStructure,
     built: Built,
+    /// Whether queries trace 16-ray packets (`TriangleBvh` only).
+    packets: bool,
 }
 
 /// The structure itself.
@@ -103,21 +106,47 @@ impl EnglobeLibrary {
         match structure {
             EnglobeStructure::World(kind) => {
                 let world = World::build(vec![Object::Mesh(scene.mesh.clone())], kind)?;
-                Ok(EnglobeLibrary { structure, built: Built::World(Box::new(world)) })
+                Ok(EnglobeLibrary { structure, built: Built::World(Box::new(world)), packets: false })
             }
             EnglobeStructure::Triangles(isa) => {
                 let mut bvh = TriangleBvh::build(&scene.mesh);
                 if let Some(isa) = isa {
                     bvh.set_isa(isa)?;
                 }
-                Ok(EnglobeLibrary { structure, built: Built::Triangles(bvh) })
+                Ok(EnglobeLibrary { structure, built: Built::Triangles(bvh), packets: false })
             }
         }
     }
+
+    /// Builds `structure`, which must be the triangle BVH, for queries in 16-ray packets: each
+    /// group of 16 rays the harness hands over is traced as one packet, as Embree's
+    /// `rtcIntersect16` is.
+    pub fn build_packets(scene: &BenchScene, structure: EnglobeStructure) -> anyhow::Result<Self> {
+        let structure = match structure {
+            EnglobeStructure::World(_) => EnglobeStructure::Triangles(None),
+            triangles => triangles,
+        };
+        Ok(EnglobeLibrary { packets: true, ..Self::build(scene, structure)? })
+    }
+}
+
+/// The rays of a packet, converted.
+fn packet_rays(rays: &[BenchRay], out: &mut [Ray; PACKET]) -> usize {
+    for (o, r) in out.iter_mut().zip(rays) {
+        *o = r.to_englobe();
+    }
+    rays.len().min(PACKET)
 }
 
 impl Library for EnglobeLibrary {
+    fn packet_width(&self) -> usize {
+        if self.packets { PACKET } else { 1 }
+    }
+
     fn structure(&self) -> String {
+        if let (true, Built::Triangles(bvh)) = (self.packets, &self.built) {
+            return format!("{TRIANGLE_BVH} ({}), 16-ray packets", bvh.isa());
+        }
         match (&self.structure, &self.built) {
             (EnglobeStructure::World(kind), _) => format!("{} through World", kind.name()),
             (_, Built::Triangles(bvh)) => format!("{TRIANGLE_BVH} ({})", bvh.isa()),
@@ -126,6 +155,18 @@ impl Library for EnglobeLibrary {
     }
 
     fn closest_hits(&self, rays: &[BenchRay], out: &mut [RayResult]) {
+        if let (true, Built::Triangles(bvh)) = (self.packets, &self.built) {
+            let mut packet = [Ray::new(Vec3::ZERO, Vec3::Z); PACKET];
+            let mut hits = [None; PACKET];
+            for (rays, out) in rays.chunks(PACKET).zip(out.chunks_mut(PACKET)) {
+                let n = packet_rays(rays, &mut packet);
+                bvh.closest_hit_packet(&packet[..n], &mut hits[..n], &mut NoCount).expect("as many hits as rays");
+                for (o, h) in out.iter_mut().zip(&hits) {
+                    *o = h.map_or(RayResult::MISS, |h| RayResult::hit(h.t, h.prim));
+                }
+            }
+            return;
+        }
         match &self.built {
             Built::World(world) => {
                 for (ray, out) in rays.iter().zip(out) {
@@ -143,6 +184,14 @@ impl Library for EnglobeLibrary {
     }
 
     fn any_hits(&self, rays: &[BenchRay], out: &mut [bool]) {
+        if let (true, Built::Triangles(bvh)) = (self.packets, &self.built) {
+            let mut packet = [Ray::new(Vec3::ZERO, Vec3::Z); PACKET];
+            for (rays, out) in rays.chunks(PACKET).zip(out.chunks_mut(PACKET)) {
+                let n = packet_rays(rays, &mut packet);
+                bvh.any_hit_packet(&packet[..n], out, &mut NoCount).expect("as many answers as rays");
+            }
+            return;
+        }
         match &self.built {
             Built::World(world) => {
                 for (ray, out) in rays.iter().zip(out) {

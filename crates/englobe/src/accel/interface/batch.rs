@@ -47,3 +47,33 @@ pub fn run_batch<T: Send>(
     }
     Ok(())
 }
+
+/// Calls `query` on consecutive pieces of `rays` and `out`, `width` rays at a time (the last
+/// piece perhaps shorter), in parallel above [`PARALLEL_BATCH`] rays when the `parallel` feature
+/// is on: for queries that trace several rays together (packets).
+pub fn run_batch_chunks<T: Send>(
+    rays: &[Ray],
+    out: &mut [T],
+    width: usize,
+    query: impl Fn(&[Ray], &mut [T]) + Sync,
+) -> Result<(), BatchSizeMismatch> {
+    if rays.len() != out.len() {
+        return Err(BatchSizeMismatch { rays: rays.len(), outputs: out.len() });
+    }
+    // A thread's share is a whole number of pieces, so that no piece is cut in two.
+    let share = CHUNK.div_ceil(width) * width;
+    let run = |out: &mut [T], rays: &[Ray]| {
+        for (o, r) in out.chunks_mut(width).zip(rays.chunks(width)) {
+            query(r, o);
+        }
+    };
+    #[cfg(feature = "parallel")]
+    if rays.len() >= PARALLEL_BATCH {
+        use rayon::prelude::*;
+        out.par_chunks_mut(share).zip(rays.par_chunks(share)).for_each(|(out, rays)| run(out, rays));
+        return Ok(());
+    }
+    let _ = share;
+    run(out, rays);
+    Ok(())
+}

@@ -9,6 +9,8 @@
 use super::isa::Isa;
 use super::kernels::Portable;
 use super::node::{NodeRay, WideNode};
+use super::packet::{self, PacketLeaves};
+use super::packet_kernels::{PacketRays, ScalarPacket};
 use super::traverse::{self, Leaves};
 use crate::accel::Counters;
 
@@ -62,6 +64,55 @@ pub fn any<C: Counters, L: Leaves<C>>(
     }
 }
 
+/// The packet closest-hit traversal compiled for `isa` (see [`closest`]); `depth` must
+/// [`packet::fits`].
+#[inline(always)]
+pub fn closest_packet<C: Counters, L: PacketLeaves<C>>(
+    isa: Isa,
+    nodes: &[WideNode],
+    rays: &PacketRays,
+    active: u32,
+    leaves: &mut L,
+    counters: &mut C,
+) {
+    debug_assert!(isa.is_available());
+    match isa {
+        Isa::Portable => portable::closest_packet(nodes, rays, active, leaves, counters),
+        // SAFETY: the structure's instruction set is one the processor has (module documentation).
+        #[cfg(target_arch = "x86_64")]
+        Isa::Avx2 => unsafe { x86::closest_packet_avx2(nodes, rays, active, leaves, counters) },
+        // SAFETY: as above.
+        #[cfg(target_arch = "x86_64")]
+        Isa::Avx512 => unsafe { x86::closest_packet_avx512(nodes, rays, active, leaves, counters) },
+        #[cfg(not(target_arch = "x86_64"))]
+        _ => unreachable!("x86 instruction sets are never available elsewhere"),
+    }
+}
+
+/// The packet any-hit traversal compiled for `isa` (see [`closest_packet`]): the rays that hit.
+#[inline(always)]
+pub fn any_packet<C: Counters, L: PacketLeaves<C>>(
+    isa: Isa,
+    nodes: &[WideNode],
+    rays: &PacketRays,
+    active: u32,
+    leaves: &mut L,
+    counters: &mut C,
+) -> u32 {
+    debug_assert!(isa.is_available());
+    match isa {
+        Isa::Portable => portable::any_packet(nodes, rays, active, leaves, counters),
+        // SAFETY: the structure's instruction set is one the processor has (module documentation).
+        #[cfg(target_arch = "x86_64")]
+        Isa::Avx2 => unsafe { x86::any_packet_avx2(nodes, rays, active, leaves, counters) },
+        // SAFETY: as above.
+        #[cfg(target_arch = "x86_64")]
+        Isa::Avx512 => unsafe { x86::any_packet_avx512(nodes, rays, active, leaves, counters) },
+        #[cfg(not(target_arch = "x86_64"))]
+        _ => unreachable!("x86 instruction sets are never available elsewhere"),
+    }
+}
+
 /// The portable copies, compiled apart like the others rather than inlined into every caller:
 /// inlined, their code and stack would weigh on the caller's registers and frame on machines that
 /// run another copy.
@@ -92,11 +143,36 @@ mod portable {
         // SAFETY: as above.
         unsafe { traverse::any(Portable, nodes, depth, ray, limit, leaves, counters) }
     }
+
+    #[inline(never)]
+    pub fn closest_packet<C: Counters, L: PacketLeaves<C>>(
+        nodes: &[WideNode],
+        rays: &PacketRays,
+        active: u32,
+        leaves: &mut L,
+        counters: &mut C,
+    ) {
+        // SAFETY: as above.
+        unsafe { packet::closest(ScalarPacket, nodes, rays, active, leaves, counters) }
+    }
+
+    #[inline(never)]
+    pub fn any_packet<C: Counters, L: PacketLeaves<C>>(
+        nodes: &[WideNode],
+        rays: &PacketRays,
+        active: u32,
+        leaves: &mut L,
+        counters: &mut C,
+    ) -> u32 {
+        // SAFETY: as above.
+        unsafe { packet::any(ScalarPacket, nodes, rays, active, leaves, counters) }
+    }
 }
 
 #[cfg(target_arch = "x86_64")]
 mod x86 {
     use super::super::kernels::{Avx2, Avx512};
+    use super::super::packet_kernels::{Avx2Packet, Avx512Packet};
     use super::*;
 
     /// # Safety
@@ -155,5 +231,61 @@ mod x86 {
     ) -> bool {
         // SAFETY: compiled with AVX-512, which the caller guarantees.
         unsafe { traverse::any(Avx512, nodes, depth, ray, limit, leaves, counters) }
+    }
+
+    /// # Safety
+    /// The processor has AVX2 and FMA.
+    #[target_feature(enable = "avx2,fma")]
+    pub unsafe fn closest_packet_avx2<C: Counters, L: PacketLeaves<C>>(
+        nodes: &[WideNode],
+        rays: &PacketRays,
+        active: u32,
+        leaves: &mut L,
+        counters: &mut C,
+    ) {
+        // SAFETY: compiled with AVX2, which the caller guarantees.
+        unsafe { packet::closest(Avx2Packet, nodes, rays, active, leaves, counters) }
+    }
+
+    /// # Safety
+    /// The processor has AVX-512 F, VL, BW and DQ (and AVX2).
+    #[target_feature(enable = "avx2,fma,avx512f,avx512vl,avx512bw,avx512dq")]
+    pub unsafe fn closest_packet_avx512<C: Counters, L: PacketLeaves<C>>(
+        nodes: &[WideNode],
+        rays: &PacketRays,
+        active: u32,
+        leaves: &mut L,
+        counters: &mut C,
+    ) {
+        // SAFETY: compiled with AVX-512, which the caller guarantees.
+        unsafe { packet::closest(Avx512Packet, nodes, rays, active, leaves, counters) }
+    }
+
+    /// # Safety
+    /// The processor has AVX2 and FMA.
+    #[target_feature(enable = "avx2,fma")]
+    pub unsafe fn any_packet_avx2<C: Counters, L: PacketLeaves<C>>(
+        nodes: &[WideNode],
+        rays: &PacketRays,
+        active: u32,
+        leaves: &mut L,
+        counters: &mut C,
+    ) -> u32 {
+        // SAFETY: compiled with AVX2, which the caller guarantees.
+        unsafe { packet::any(Avx2Packet, nodes, rays, active, leaves, counters) }
+    }
+
+    /// # Safety
+    /// The processor has AVX-512 F, VL, BW and DQ (and AVX2).
+    #[target_feature(enable = "avx2,fma,avx512f,avx512vl,avx512bw,avx512dq")]
+    pub unsafe fn any_packet_avx512<C: Counters, L: PacketLeaves<C>>(
+        nodes: &[WideNode],
+        rays: &PacketRays,
+        active: u32,
+        leaves: &mut L,
+        counters: &mut C,
+    ) -> u32 {
+        // SAFETY: compiled with AVX-512, which the caller guarantees.
+        unsafe { packet::any(Avx512Packet, nodes, rays, active, leaves, counters) }
     }
 }

@@ -17,9 +17,12 @@
 //! * [`convert`](mod@convert): binary tree to wide nodes (largest boxes pulled up first).
 //! * [`isa`]: the instruction sets, detected at run time; [`kernels`]: the slab test of eight
 //!   children for each; `dispatch` (inside the crate): the per-query choice.
-//! * [`traverse`]: the single-ray traversal, generic over kernels and leaves.
+//! * [`traverse`]: the single-ray traversal, generic over kernels and leaves; [`packet`]: the
+//!   traversal of packets of up to sixteen rays, with [`packet_kernels`], their node tests, and
+//!   [`packet_triangles`], the triangle test of a whole packet.
 //! * [`triangles`]: blocks of four triangles and their SIMD watertight test; [`triangle_bvh`]:
-//!   [`TriangleBvh`]; [`presplit`]: the large triangles cut before its build.
+//!   [`TriangleBvh`]; [`triangle_packet`]: its packet queries and batches; [`presplit`]: the
+//!   large triangles cut before its build.
 //! * [`point_query`]: the closest point of the triangles to a point; [`box_query`]: the
 //!   triangles overlapping a box.
 //! * [`refit`]: the boxes recomputed after the triangles moved, and the SAH cost that says when
@@ -34,11 +37,15 @@ pub(crate) mod dispatch;
 pub mod isa;
 pub mod kernels;
 pub mod node;
+pub mod packet;
+pub mod packet_kernels;
+pub mod packet_triangles;
 pub mod point_query;
 pub mod presplit;
 pub mod refit;
 pub mod traverse;
 pub mod triangle_bvh;
+pub mod triangle_packet;
 pub mod triangles;
 pub mod validate;
 

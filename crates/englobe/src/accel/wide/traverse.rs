@@ -58,7 +58,13 @@ pub trait Leaves<C: Counters> {
 /// overlap instead of following one another as the walk reaches them. A lone child is not asked
 /// for: the walk reads it next, so there is nothing for its miss to overlap with.
 #[inline(always)]
-fn prefetch_children<C: Counters, L: Leaves<C>>(nodes: &[WideNode], node: &WideNode, mut mask: u32, leaves: &L) {
+fn prefetch_children<C: Counters, L: Leaves<C>>(nodes: &[WideNode], node: &WideNode, mask: u32, leaves: &L) {
+    prefetch_children_of(nodes, node, mask, |first| leaves.prefetch(first));
+}
+
+/// [`prefetch_children`] with the leaves' prefetch given as `leaf` (for the packet traversal).
+#[inline(always)]
+pub(super) fn prefetch_children_of(nodes: &[WideNode], node: &WideNode, mut mask: u32, leaf: impl Fn(u32)) {
     if mask & mask.wrapping_sub(1) == 0 {
         return;
     }
@@ -67,7 +73,7 @@ fn prefetch_children<C: Counters, L: Leaves<C>>(nodes: &[WideNode], node: &WideN
         mask &= mask - 1;
         let c = node.children[i];
         if is_leaf(c) {
-            leaves.prefetch(index_of(c));
+            leaf(index_of(c));
         } else {
             prefetch_node(nodes, c);
         }

@@ -17,10 +17,7 @@ use super::traverse::Leaves;
 use super::triangles::{LANES, TriBlock, TriRay, UNUSED, intersect_block, is_storable};
 use crate::accel::bvh::BinnedSah;
 use crate::accel::bvh::build::parallel::fill_indexed;
-use crate::accel::interface::batch::run_batch;
-use crate::accel::{
-    BatchSizeMismatch, Counters, Hit, HitFilter, LEAF_SIZE_BUCKETS, MAX_PRIMITIVES, NoCount, NoFilter, StructureStats,
-};
+use crate::accel::{Counters, Hit, HitFilter, LEAF_SIZE_BUCKETS, MAX_PRIMITIVES, NoFilter, StructureStats};
 use crate::shapes::{MeshError, TriangleMesh, check_arrays};
 use crate::{Aabb, Ray};
 
@@ -318,18 +315,6 @@ impl TriangleBvh {
         dispatch::any(self.isa, &self.nodes, self.depth, &NodeRay::new(ray), reach(ray.t_max), &mut leaves, counters)
     }
 
-    /// The closest hit of every ray, `hits[i]` for `rays[i]`: [`TriangleBvh::closest_hit`] ray
-    /// after ray, on several threads for large batches (see [`crate::accel::interface::batch`]).
-    /// The two slices must be as long.
-    pub fn closest_hits(&self, rays: &[Ray], hits: &mut [Option<Hit>]) -> Result<(), BatchSizeMismatch> {
-        run_batch(rays, hits, |r| self.closest_hit(r, &mut NoCount))
-    }
-
-    /// Whether each ray hits anything, `mask[i]` for `rays[i]` (see [`TriangleBvh::closest_hits`]).
-    pub fn any_hits(&self, rays: &[Ray], mask: &mut [bool]) -> Result<(), BatchSizeMismatch> {
-        run_batch(rays, mask, |r| self.any_hit(r, &mut NoCount))
-    }
-
     /// Size and shape: wide nodes, leaves, depth, stored triangles and bytes. The leaf sizes count
     /// triangles per leaf.
     pub fn stats(&self) -> StructureStats {
@@ -364,15 +349,15 @@ impl TriangleBvh {
 }
 
 /// A query's view of the triangle blocks, its closest hit so far, and the caller's filter.
-struct TriangleLeaves<'a, F> {
-    blocks: &'a [TriBlock],
-    source: &'a Ray,
+pub(super) struct TriangleLeaves<'a, F> {
+    pub(super) blocks: &'a [TriBlock],
+    pub(super) source: &'a Ray,
     /// The triangle test's constants, prepared at the first leaf: a ray that reaches none (one
     /// that misses the mesh's box, say) never pays for them.
-    ray: Option<TriRay>,
-    best: Option<Hit>,
-    t_max: f32,
-    filter: F,
+    pub(super) ray: Option<TriRay>,
+    pub(super) best: Option<Hit>,
+    pub(super) t_max: f32,
+    pub(super) filter: F,
 }
 
 /// Keeps the hit on triangle `prim` in `best` if it is closer, or as close with a lower index

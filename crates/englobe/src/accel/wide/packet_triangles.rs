@@ -1,0 +1,230 @@
+//! The watertight triangle test (Woop, Benthin and Wald 2013) of one triangle against a whole
+//! packet at once: sixteen rays in the lanes of an AVX-512 vector, the triangle's coordinates
+//! broadcast, as Embree's hybrid traversal tests its `Triangle4` leaves against ray packets (Wald
+//! et al. 2014). The test shears each ray's frame by its own axes; a packet whose rays share the
+//! axes (the camera rays of a tile, nearly always) reads the same rows of the block for every
+//! lane, so only those packets take this path. The others test one ray at a time.
+//!
+//! Each lane computes exactly what a lane of the single-ray block test
+//! ([`super::triangles::intersect_block`]) computes for its ray and triangle: the same operations
+//! in the same order, no fused multiply-add, the same *special* cases left to the scalar test.
+//! So every ray keeps the answer of its own query.
+
+use super::packet_kernels::{Lanes, PACKET};
+use crate::Ray;
+use crate::shapes::WatertightRay;
+
+/// A packet whose rays share the watertight test's axes, prepared for triangle tests: the
+/// constants of [`super::triangles::TriRay`] as a structure of arrays.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(64))]
+pub struct PacketTriRays {
+    /// The origins' coordinates on the axes `kx`, `ky`, `kz`.
+    origin_k: [Lanes; 3],
+    /// The origins by axis `x`, `y`, `z`.
+    origin: [Lanes; 3],
+    /// The inverse directions by axis.
+    inv_dir: [Lanes; 3],
+    /// The shears `(d[kx] / d[kz], d[ky] / d[kz], 1 / d[kz])`.
+    shear: [Lanes; 3],
+    t_min: Lanes,
+    axes: [usize; 3],
+}
+
+impl PacketTriRays {
+    /// Prepares the rays of `active` (bit per ray of `rays`), or `None` if they do not all share
+    /// the watertight test's axes.
+    pub fn new(rays: &[Ray], active: u32) -> Option<Self> {
+        let zero = Lanes([0.0; PACKET]);
+        let mut p = PacketTriRays {
+            origin_k: [zero; 3],
+            origin: [zero; 3],
+            inv_dir: [zero; 3],
+            shear: [zero; 3],
+            t_min: zero,
+            axes: [0; 3],
+        };
+        let mut first = true;
+        for (i, ray) in rays.iter().enumerate().take(PACKET) {
+            if active >> i & 1 == 0 {
+                continue;
+            }
+            let w = WatertightRay::new(ray);
+            if first {
+                (p.axes, first) = (w.axes(), false);
+            } else if w.axes() != p.axes {
+                return None;
+            }
+            let (o, inv, s) = (ray.origin(), ray.inv_dir(), w.shear());
+            for a in 0..3 {
+                p.origin_k[a].0[i] = o[p.axes[a]];
+                p.origin[a].0[i] = o[a];
+                p.inv_dir[a].0[i] = inv[a];
+                p.shear[a].0[i] = s[a];
+            }
+            p.t_min.0[i] = ray.t_min;
+        }
+        Some(p)
+    }
+
+    /// The axes `[kx, ky, kz]` the rays share.
+    pub fn axes(&self) -> [usize; 3] {
+        self.axes
+    }
+}
+
+/// The closest hit of each ray of a packet so far, as a structure of arrays. A ray without a hit
+/// has `prim` [`u32::MAX`] and `t` its `t_max`.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(64))]
+pub struct PacketBest {
+    /// Distances: of the hit, or the ray's `t_max`.
+    pub t: Lanes,
+    /// First barycentric.
+    pub u: Lanes,
+    /// Second barycentric.
+    pub v: Lanes,
+    /// Triangle indices (as the bits of floats, so that the whole record moves in vectors).
+    pub prim: Lanes,
+}
+
+impl PacketBest {
+    /// No hit yet, each ray's interval ending at its `t_max`.
+    pub fn new(rays: &[Ray]) -> Self {
+        let none = Lanes([f32::from_bits(u32::MAX); PACKET]);
+        let t = Lanes(std::array::from_fn(|i| rays.get(i).map_or(0.0, |r| r.t_max)));
+        PacketBest { t, u: Lanes([0.0; PACKET]), v: Lanes([0.0; PACKET]), prim: none }
+    }
+
+    /// The triangle ray `i` hits, if any.
+    #[inline(always)]
+    pub fn prim(&self, i: usize) -> u32 {
+        self.prim.0[i].to_bits()
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+pub use x86::block_avx512;
+
+#[cfg(target_arch = "x86_64")]
+mod x86 {
+    use std::arch::x86_64::*;
+
+    use super::super::triangles::{LANES, TriBlock, UNUSED};
+    use super::{PacketBest, PacketTriRays};
+    use crate::geom::aabb::ROBUST_FAR_SCALE;
+
+    /// Tests the rays of `rays` against every used triangle of `block`. With `closest`, keeps
+    /// each ray's closest hit in `best` (closer, or as close with a lower index, as
+    /// [`crate::accel::HitRecord::offer`]); without, only reports hits within `best.t`. Returns
+    /// the rays that hit, and the pairs the scalar test must decide (bit `16 * lane + ray`).
+    ///
+    /// # Safety
+    /// The processor has AVX-512 F (and the features enabled here).
+    #[target_feature(enable = "avx2,fma,avx512f,avx512vl,avx512bw,avx512dq")]
+    pub unsafe fn block_avx512(
+        block: &TriBlock,
+        r: &PacketTriRays,
+        rays: u32,
+        best: &mut PacketBest,
+        closest: bool,
+    ) -> (u32, u64) {
+        let rays = rays as __mmask16;
+        // SAFETY: every `Lanes` is 64 bytes aligned to 64.
+        let load = |l: &super::Lanes| unsafe { _mm512_load_ps(l.0.as_ptr()) };
+        let [kx, ky, kz] = r.axes;
+        let o_k = [load(&r.origin_k[0]), load(&r.origin_k[1]), load(&r.origin_k[2])];
+        let (sx, sy, sz) = (load(&r.shear[0]), load(&r.shear[1]), load(&r.shear[2]));
+        let zero = _mm512_setzero_ps();
+        let abs = |x: __m512| _mm512_abs_ps(x);
+        let normal = |x: __m512| {
+            _mm512_cmp_ps_mask::<_CMP_GE_OQ>(abs(x), _mm512_set1_ps(f32::MIN_POSITIVE))
+                & _mm512_cmp_ps_mask::<_CMP_LT_OQ>(abs(x), _mm512_set1_ps(f32::INFINITY))
+        };
+        let (mut hit_rays, mut special_pairs) = (0u16, 0u64);
+        for lane in 0..LANES {
+            let id = block.ids[lane];
+            if id == UNUSED {
+                continue;
+            }
+            let at = |k: usize, axis: usize| block.v[3 * k + axis][lane];
+            // Vertex k relative to the origin, sheared: the block test's `ax`, `ay`, `az`.
+            let project = |k: usize| {
+                let x = _mm512_sub_ps(_mm512_set1_ps(at(k, kx)), o_k[0]);
+                let y = _mm512_sub_ps(_mm512_set1_ps(at(k, ky)), o_k[1]);
+                let z = _mm512_sub_ps(_mm512_set1_ps(at(k, kz)), o_k[2]);
+                (_mm512_sub_ps(x, _mm512_mul_ps(sx, z)), _mm512_sub_ps(y, _mm512_mul_ps(sy, z)), z)
+            };
+            let (ax, ay, a_z) = project(0);
+            let (bx, by, b_z) = project(1);
+            let (cx, cy, c_z) = project(2);
+            let e0 = _mm512_sub_ps(_mm512_mul_ps(cx, by), _mm512_mul_ps(cy, bx));
+            let e1 = _mm512_sub_ps(_mm512_mul_ps(ax, cy), _mm512_mul_ps(ay, cx));
+            let e2 = _mm512_sub_ps(_mm512_mul_ps(bx, ay), _mm512_mul_ps(by, ax));
+            let lt = |e| _mm512_cmp_ps_mask::<_CMP_LT_OQ>(e, zero);
+            let gt = |e| _mm512_cmp_ps_mask::<_CMP_GT_OQ>(e, zero);
+            let negative = lt(e0) | lt(e1) | lt(e2);
+            let positive = gt(e0) | gt(e1) | gt(e2);
+            let inside = !(negative & positive) & rays;
+            if inside == 0 {
+                continue;
+            }
+            let all_normal = normal(e0) & normal(e1) & normal(e2);
+            let mut special = inside & !all_normal;
+            let candidate = inside & all_normal;
+            if candidate != 0 {
+                let (az, bz, cz) = (_mm512_mul_ps(sz, a_z), _mm512_mul_ps(sz, b_z), _mm512_mul_ps(sz, c_z));
+                let det = _mm512_add_ps(_mm512_add_ps(e0, e1), e2);
+                let t_scaled =
+                    _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(e0, az), _mm512_mul_ps(e1, bz)), _mm512_mul_ps(e2, cz));
+                let inv_det = _mm512_div_ps(_mm512_set1_ps(1.0), det);
+                let t = _mm512_mul_ps(t_scaled, inv_det);
+                let finite = _mm512_cmp_ps_mask::<_CMP_LT_OQ>(abs(t), _mm512_set1_ps(f32::INFINITY));
+                special |= candidate & !finite;
+                let candidate = candidate & finite;
+                // The box-stretch correction, as the block test computes it.
+                let (mut enter, mut exit) = (_mm512_set1_ps(f32::NEG_INFINITY), _mm512_set1_ps(f32::INFINITY));
+                for axis in 0..3 {
+                    let (p, q, s) = (at(0, axis), at(1, axis), at(2, axis));
+                    let (lo, hi) = (_mm512_set1_ps(p.min(q).min(s)), _mm512_set1_ps(p.max(q).max(s)));
+                    let inv = load(&r.inv_dir[axis]);
+                    let o = load(&r.origin[axis]);
+                    let positive_dir = _mm512_cmp_ps_mask::<_CMP_GE_OQ>(inv, zero);
+                    let near = _mm512_mask_blend_ps(positive_dir, hi, lo);
+                    let far = _mm512_mask_blend_ps(positive_dir, lo, hi);
+                    let t_near = _mm512_mul_ps(_mm512_sub_ps(near, o), inv);
+                    let t_far =
+                        _mm512_mul_ps(_mm512_mul_ps(_mm512_sub_ps(far, o), inv), _mm512_set1_ps(ROBUST_FAR_SCALE));
+                    // `max(a, b)` is `a > b ? a : b`: the block test's `keep_greater`.
+                    enter = _mm512_max_ps(t_near, enter);
+                    exit = _mm512_min_ps(t_far, exit);
+                }
+                let in_box = _mm512_cmp_ps_mask::<_CMP_LE_OQ>(enter, exit);
+                let t = _mm512_mask_blend_ps(_mm512_cmp_ps_mask::<_CMP_LT_OQ>(t, enter), t, enter);
+                let t = _mm512_mask_blend_ps(_mm512_cmp_ps_mask::<_CMP_GT_OQ>(t, exit), t, exit);
+                let best_t = load(&best.t);
+                let in_range =
+                    _mm512_cmp_ps_mask::<_CMP_GE_OQ>(t, load(&r.t_min)) & _mm512_cmp_ps_mask::<_CMP_LE_OQ>(t, best_t);
+                let hit = candidate & in_box & in_range;
+                hit_rays |= hit;
+                if closest && hit != 0 {
+                    let prim = _mm512_set1_epi32(id as i32);
+                    let best_prim = _mm512_castps_si512(load(&best.prim));
+                    let better = hit
+                        & (_mm512_cmp_ps_mask::<_CMP_LT_OQ>(t, best_t)
+                            | (_mm512_cmp_ps_mask::<_CMP_EQ_OQ>(t, best_t) & _mm512_cmplt_epu32_mask(prim, best_prim)));
+                    let store = |l: &mut super::Lanes, x: __m512| {
+                        // SAFETY: as `load`.
+                        unsafe { _mm512_store_ps(l.0.as_mut_ptr(), _mm512_mask_blend_ps(better, load(l), x)) }
+                    };
+                    store(&mut best.t, t);
+                    store(&mut best.u, _mm512_mul_ps(e1, inv_det));
+                    store(&mut best.v, _mm512_mul_ps(e2, inv_det));
+                    store(&mut best.prim, _mm512_castsi512_ps(prim));
+                }
+            }
+            special_pairs |= (special as u64) << (16 * lane);
+        }
+        (hit_rays as u32, special_pairs)
+    }
+}

@@ -1,0 +1,324 @@
+//! Packets of rays on [`TriangleBvh`]: up to [`PACKET`] rays walk the tree together (see
+//! [`super::packet`]), each ray's leaves tested by the single-ray block test, so that every ray
+//! gets exactly the answer of its own query. Batches choose, sixteen rays at a time, between a
+//! packet (coherent rays: near origins, near directions) and single rays.
+
+use super::dispatch;
+use super::isa::Isa;
+use super::node::reach;
+use super::packet::{self, PacketLeaves};
+use super::packet_kernels::{Lanes, PACKET, PacketRays};
+#[cfg(target_arch = "x86_64")]
+use super::packet_triangles;
+use super::packet_triangles::{PacketBest, PacketTriRays};
+use super::traverse::Leaves;
+use super::triangle_bvh::{TriangleBvh, TriangleLeaves};
+use super::triangles::{TriBlock, TriRay};
+use crate::accel::interface::batch::run_batch_chunks;
+use crate::accel::{BatchSizeMismatch, Counters, Hit, NoCount, NoFilter};
+use crate::{Aabb, Ray};
+
+/// The rays of a packet and their state: with AVX-512 and rays sharing the watertight test's
+/// axes, the packet's closest hits and triangle constants as structures of arrays (each triangle
+/// tested against the whole packet at once); otherwise each ray's single-ray leaf state.
+struct TrianglePacket<'a> {
+    rays: &'a [Ray],
+    blocks: &'a [TriBlock],
+    lanes: [TriangleLeaves<'a, NoFilter>; PACKET],
+    /// The shared-axes constants, when the packet's triangle tests run on whole packets;
+    /// prepared at the first leaf (rays that reach none never pay for them).
+    simd: Option<PacketTriRays>,
+    /// Whether `simd` has been decided (it stays `None` for rays of different axes, and on
+    /// processors without AVX-512).
+    decided: bool,
+    active: u32,
+    best: PacketBest,
+    limits: Lanes,
+}
+
+impl<'a> TrianglePacket<'a> {
+    /// The leaf states of `rays` (at least one; lanes beyond them repeat the first and are never
+    /// asked for), of which `active` will be traced.
+    fn new(bvh: &'a TriangleBvh, rays: &'a [Ray], active: u32) -> Self {
+        let lanes = std::array::from_fn(|i| {
+            let source = rays.get(i).unwrap_or(&rays[0]);
+            TriangleLeaves {
+                blocks: bvh.blocks(),
+                source,
+                ray: None,
+                best: None,
+                t_max: source.t_max,
+                filter: NoFilter,
+            }
+        });
+        let limits = Lanes(std::array::from_fn(|i| reach(rays.get(i).unwrap_or(&rays[0]).t_max)));
+        // Only AVX-512 has the whole-packet triangle test.
+        let decided = !(cfg!(target_arch = "x86_64") && bvh.isa() == Isa::Avx512);
+        TrianglePacket {
+            rays,
+            blocks: bvh.blocks(),
+            lanes,
+            simd: None,
+            decided,
+            active,
+            best: PacketBest::new(rays),
+            limits,
+        }
+    }
+
+    /// The whole-packet triangle constants, if the packet's rays share their axes (see `simd`).
+    #[inline(always)]
+    fn simd(&mut self) -> Option<PacketTriRays> {
+        if !self.decided {
+            self.decided = true;
+            self.simd = PacketTriRays::new(self.rays, self.active);
+        }
+        self.simd
+    }
+
+    /// The closest hit of ray `i`.
+    fn hit(&self, i: usize) -> Option<Hit> {
+        if self.simd.is_none() {
+            // Per-ray leaves, or no leaf reached: `best` is each ray's own.
+            return self.lanes[i].best;
+        }
+        let b = &self.best;
+        (b.prim(i) != u32::MAX).then(|| Hit { t: b.t.0[i], prim: b.prim(i), u: b.u.0[i], v: b.v.0[i] })
+    }
+
+    /// Keeps `hit` as ray `i`'s closest if it is closer, or as close with a lower index.
+    fn offer(&mut self, i: usize, hit: Hit) {
+        let b = &mut self.best;
+        if hit.t < b.t.0[i] || (hit.t == b.t.0[i] && hit.prim < b.prim(i)) {
+            (b.t.0[i], b.u.0[i], b.v.0[i], b.prim.0[i]) = (hit.t, hit.u, hit.v, f32::from_bits(hit.prim));
+        }
+    }
+
+    /// Tests the blocks from `first` against the rays of `rays` a whole packet at a time; returns
+    /// the rays that hit (with `closest`, their closest hits are kept).
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    fn simd_blocks<C: Counters>(
+        &mut self,
+        tri: &PacketTriRays,
+        first: u32,
+        count: u32,
+        rays: u32,
+        closest: bool,
+        counters: &mut C,
+    ) -> u32 {
+        let mut found = 0;
+        for block in &self.blocks[first as usize..(first + count) as usize] {
+            for _ in 0..block.used() * rays.count_ones() {
+                counters.exact_test();
+            }
+            // SAFETY: `simd` is only prepared for structures whose instruction set is AVX-512,
+            // which the processor has (see `Isa`).
+            let (hit, mut special) =
+                unsafe { packet_triangles::block_avx512(block, tri, rays & !found, &mut self.best, closest) };
+            found |= hit;
+            while special != 0 {
+                let bit = special.trailing_zeros() as usize;
+                special &= special - 1;
+                let (lane, i) = (bit / PACKET, bit % PACKET);
+                if closest || found >> i & 1 == 0 {
+                    let t_max = self.best.t.0[i];
+                    if let Some(h) = TriRay::scalar(&self.rays[i], block, lane, t_max) {
+                        found |= 1 << i;
+                        self.offer(i, Hit { t: h.t, prim: block.ids[lane], u: h.u, v: h.v });
+                    }
+                }
+            }
+            if !closest && found == rays {
+                break;
+            }
+            if closest {
+                found = 0;
+            }
+        }
+        found
+    }
+}
+
+impl<C: Counters> PacketLeaves<C> for TrianglePacket<'_> {
+    #[inline(always)]
+    fn closest(&mut self, first: u32, count: u32, mut rays: u32, counters: &mut C) {
+        #[cfg(target_arch = "x86_64")]
+        if let Some(tri) = self.simd() {
+            self.simd_blocks(&tri, first, count, rays, true, counters);
+            while rays != 0 {
+                let i = rays.trailing_zeros() as usize;
+                rays &= rays - 1;
+                self.limits.0[i] = reach(self.best.t.0[i]);
+            }
+            return;
+        }
+        while rays != 0 {
+            let i = rays.trailing_zeros() as usize;
+            rays &= rays - 1;
+            let lane = &mut self.lanes[i];
+            Leaves::<C>::closest(lane, first, count, counters);
+            self.limits.0[i] = reach(lane.t_max);
+        }
+    }
+
+    #[inline(always)]
+    fn any(&mut self, first: u32, count: u32, mut rays: u32, counters: &mut C) -> u32 {
+        #[cfg(target_arch = "x86_64")]
+        if let Some(tri) = self.simd() {
+            return self.simd_blocks(&tri, first, count, rays, false, counters);
+        }
+        let mut found = 0;
+        while rays != 0 {
+            let i = rays.trailing_zeros() as usize;
+            rays &= rays - 1;
+            if Leaves::<C>::any(&mut self.lanes[i], first, count, counters) {
+                found |= 1 << i;
+            }
+        }
+        found
+    }
+
+    #[inline(always)]
+    fn limits(&self) -> &Lanes {
+        &self.limits
+    }
+
+    #[inline(always)]
+    fn prefetch(&self, first: u32) {
+        Leaves::<C>::prefetch(&self.lanes[0], first);
+    }
+}
+
+/// The rays of `rays` that a query can take (see [`Ray::is_valid`]), bit per ray.
+fn valid_mask(rays: &[Ray]) -> u32 {
+    rays.iter().enumerate().fold(0, |m, (i, r)| m | (r.is_valid() as u32) << i)
+}
+
+/// Whether `rays` are coherent enough to walk the tree together: directions within about 25
+/// degrees of the first ray's, and origins within a fiftieth of the tree's diagonal of its origin.
+/// Rays that go apart visit the union of their paths, which costs more than walking alone.
+pub fn coherent(rays: &[Ray], bounds: &Aabb) -> bool {
+    let Some(first) = rays.first() else { return false };
+    let d0 = first.dir().normalize_or_zero();
+    let reach = 0.02 * (bounds.max - bounds.min).length();
+    rays.iter().all(|r| {
+        r.dir().normalize_or_zero().dot(d0) >= 0.9 && r.origin().distance(first.origin()) <= reach && r.is_valid()
+    })
+}
+
+impl TriangleBvh {
+    /// The closest hit of every ray, `hits[i]` for `rays[i]`, as [`TriangleBvh::closest_hit`]
+    /// gives it, the rays walking the tree in packets of sixteen: for coherent rays (a camera's,
+    /// shadow rays from neighbouring points towards one light), each node is tested once per
+    /// packet instead of once per ray. The two slices must be as long.
+    ///
+    /// ```
+    /// use englobe::{NoCount, Ray, TriangleBvh, Vec3};
+    ///
+    /// let bvh = TriangleBvh::from_triangles(&[[Vec3::ZERO, Vec3::X, Vec3::Y]]);
+    /// let rays: Vec<Ray> = (0..16).map(|i| Ray::new(Vec3::new(0.01 * i as f32, 0.1, 1.0), -Vec3::Z)).collect();
+    /// let mut hits = vec![None; rays.len()];
+    /// bvh.closest_hit_packet(&rays, &mut hits, &mut NoCount).unwrap();
+    /// assert!(hits.iter().all(|h| h.is_some_and(|h| h.t == 1.0)));
+    /// ```
+    pub fn closest_hit_packet<C: Counters>(
+        &self,
+        rays: &[Ray],
+        hits: &mut [Option<Hit>],
+        counters: &mut C,
+    ) -> Result<(), BatchSizeMismatch> {
+        if rays.len() != hits.len() {
+            return Err(BatchSizeMismatch { rays: rays.len(), outputs: hits.len() });
+        }
+        for (rays, hits) in rays.chunks(PACKET).zip(hits.chunks_mut(PACKET)) {
+            self.closest_packet_of(rays, hits, counters);
+        }
+        Ok(())
+    }
+
+    /// Whether each ray hits anything, `mask[i]` for `rays[i]`, in packets of sixteen (see
+    /// [`TriangleBvh::closest_hit_packet`]).
+    pub fn any_hit_packet<C: Counters>(
+        &self,
+        rays: &[Ray],
+        mask: &mut [bool],
+        counters: &mut C,
+    ) -> Result<(), BatchSizeMismatch> {
+        if rays.len() != mask.len() {
+            return Err(BatchSizeMismatch { rays: rays.len(), outputs: mask.len() });
+        }
+        for (rays, mask) in rays.chunks(PACKET).zip(mask.chunks_mut(PACKET)) {
+            self.any_packet_of(rays, mask, counters);
+        }
+        Ok(())
+    }
+
+    /// The closest hit of every ray (see [`TriangleBvh::closest_hit`]), on several threads for
+    /// large batches (see [`crate::accel::interface::batch`]); sixteen rays at a time, in a packet
+    /// when they are coherent, one by one otherwise. The two slices must be as long.
+    pub fn closest_hits(&self, rays: &[Ray], hits: &mut [Option<Hit>]) -> Result<(), BatchSizeMismatch> {
+        run_batch_chunks(rays, hits, PACKET, |rays, hits| {
+            if coherent(rays, &self.bounds()) {
+                self.closest_packet_of(rays, hits, &mut NoCount);
+            } else {
+                for (h, r) in hits.iter_mut().zip(rays) {
+                    *h = self.closest_hit(r, &mut NoCount);
+                }
+            }
+        })
+    }
+
+    /// Whether each ray hits anything, `mask[i]` for `rays[i]` (see [`TriangleBvh::closest_hits`]).
+    pub fn any_hits(&self, rays: &[Ray], mask: &mut [bool]) -> Result<(), BatchSizeMismatch> {
+        run_batch_chunks(rays, mask, PACKET, |rays, mask| {
+            if coherent(rays, &self.bounds()) {
+                self.any_packet_of(rays, mask, &mut NoCount);
+            } else {
+                for (m, r) in mask.iter_mut().zip(rays) {
+                    *m = self.any_hit(r, &mut NoCount);
+                }
+            }
+        })
+    }
+
+    /// One packet of 1 to [`PACKET`] rays.
+    fn closest_packet_of<C: Counters>(&self, rays: &[Ray], hits: &mut [Option<Hit>], counters: &mut C) {
+        debug_assert!(rays.len() <= PACKET && rays.len() == hits.len());
+        if rays.is_empty() {
+            return;
+        }
+        if self.nodes().is_empty() || !packet::fits(self.depth()) {
+            for (h, r) in hits.iter_mut().zip(rays) {
+                *h = self.closest_hit(r, counters);
+            }
+            return;
+        }
+        let active = valid_mask(rays);
+        let mut leaves = TrianglePacket::new(self, rays, active);
+        dispatch::closest_packet(self.isa(), self.nodes(), &PacketRays::new(rays), active, &mut leaves, counters);
+        for (i, h) in hits.iter_mut().enumerate() {
+            *h = leaves.hit(i);
+        }
+    }
+
+    /// One packet of 1 to [`PACKET`] rays.
+    fn any_packet_of<C: Counters>(&self, rays: &[Ray], mask: &mut [bool], counters: &mut C) {
+        debug_assert!(rays.len() <= PACKET && rays.len() == mask.len());
+        if rays.is_empty() {
+            return;
+        }
+        if self.nodes().is_empty() || !packet::fits(self.depth()) {
+            for (m, r) in mask.iter_mut().zip(rays) {
+                *m = self.any_hit(r, counters);
+            }
+            return;
+        }
+        let active = valid_mask(rays);
+        let mut leaves = TrianglePacket::new(self, rays, active);
+        let hit = dispatch::any_packet(self.isa(), self.nodes(), &PacketRays::new(rays), active, &mut leaves, counters);
+        for (i, m) in mask.iter_mut().enumerate() {
+            *m = hit >> i & 1 != 0;
+        }
+    }
+}
