@@ -60,6 +60,15 @@ impl WatertightRay {
     #[inline(always)]
     pub fn new(ray: &Ray) -> Self {
         let d = ray.dir();
+        let [kx, ky, kz] = Self::axes_of(d);
+        let shear = Vec3::new(d[kx] / d[kz], d[ky] / d[kz], 1.0 / d[kz]);
+        WatertightRay { kx, ky, kz, shear }
+    }
+
+    /// The axes `[kx, ky, kz]` of a ray of direction `d` (see [`WatertightRay::axes`]), without
+    /// the shear.
+    #[inline(always)]
+    pub fn axes_of(d: Vec3) -> [usize; 3] {
         let a = d.abs();
         let kz = if a.x >= a.y && a.x >= a.z {
             0
@@ -73,8 +82,7 @@ impl WatertightRay {
         if d[kz] < 0.0 {
             std::mem::swap(&mut kx, &mut ky);
         }
-        let shear = Vec3::new(d[kx] / d[kz], d[ky] / d[kz], 1.0 / d[kz]);
-        WatertightRay { kx, ky, kz, shear }
+        [kx, ky, kz]
     }
 
     /// The axes `[kx, ky, kz]`: the ray runs along `kz` in the sheared frame.

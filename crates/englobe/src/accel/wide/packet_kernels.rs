@@ -15,8 +15,9 @@
 //! The kernels are `unsafe` only because the x86 ones need their instruction set (see
 //! [`super::kernels`]).
 
-use super::node::{EMPTY, NodeRay, WIDTH, WideNode};
+use super::node::{EMPTY, WIDTH, WideNode};
 use crate::Ray;
+use crate::geom::aabb::ROBUST_FAR_SCALE;
 
 /// Rays in one packet, at most.
 pub const PACKET: usize = 16;
@@ -26,7 +27,8 @@ pub const PACKET: usize = 16;
 #[repr(C, align(64))]
 pub struct Lanes(pub [f32; PACKET]);
 
-/// A packet prepared for node tests: each ray's [`NodeRay`], as a structure of arrays.
+/// A packet prepared for node tests: each ray's [`super::node::NodeRay`], as a structure of
+/// arrays.
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(64))]
 pub struct PacketRays {
@@ -34,7 +36,7 @@ pub struct PacketRays {
     pub origin: [Lanes; 3],
     /// Inverse directions.
     pub inv_dir: [Lanes; 3],
-    /// Inverse directions times the robust far scale (see [`NodeRay::inv_far`]).
+    /// Inverse directions times the robust far scale (see [`super::node::NodeRay::inv_far`]).
     pub inv_far: [Lanes; 3],
     /// The rays' `t_min`.
     pub t_min: Lanes,
@@ -50,15 +52,20 @@ impl PacketRays {
         debug_assert!(rays.len() <= PACKET);
         let zero = Lanes([0.0; PACKET]);
         let mut p = PacketRays { origin: [zero; 3], inv_dir: [zero; 3], inv_far: [zero; 3], t_min: zero, down: [0; 3] };
+        // What `NodeRay::new` computes, ray by ray, then lane by lane where a vector loop can.
         for (i, ray) in rays.iter().enumerate().take(PACKET) {
-            let r = NodeRay::new(ray);
+            let (o, inv) = (ray.origin(), ray.inv_dir());
             for a in 0..3 {
-                p.origin[a].0[i] = r.origin[a];
-                p.inv_dir[a].0[i] = r.inv_dir[a];
-                p.inv_far[a].0[i] = r.inv_far[a];
-                p.down[a] |= ((r.inv_dir[a] < 0.0) as u32) << i;
+                p.origin[a].0[i] = o[a];
+                p.inv_dir[a].0[i] = inv[a];
             }
-            p.t_min.0[i] = r.t_min;
+            p.t_min.0[i] = ray.t_min;
+        }
+        for a in 0..3 {
+            for i in 0..PACKET {
+                p.inv_far[a].0[i] = p.inv_dir[a].0[i] * ROBUST_FAR_SCALE;
+                p.down[a] |= ((p.inv_dir[a].0[i] < 0.0) as u32) << i;
+            }
         }
         p
     }
@@ -204,6 +211,10 @@ mod x86 {
                 let down = rays.down.map(|d| d as __mmask16);
                 let (t_min, lim) = (load(&rays.t_min), load(limit));
                 let nan = _mm512_set1_ps(f32::NAN);
+                // When the active rays go the same way along every axis (a camera's tile, nearly
+                // always), each axis's near and far rows are the same for all of them: no blend.
+                let same_way = rays.down.iter().all(|&d| d & active == 0 || d & active == active);
+                let rows = rays.down.map(|d| (d & active != 0) as usize);
                 let mut mask = 0;
                 for c in 0..WIDTH {
                     if node.children[c] == EMPTY {
@@ -211,11 +222,22 @@ mod x86 {
                     }
                     let (mut enter, mut exit) = (t_min, lim);
                     for a in 0..3 {
-                        let lo = _mm512_sub_ps(_mm512_set1_ps(node.bounds[2 * a][c]), o[a]);
-                        let hi = _mm512_sub_ps(_mm512_set1_ps(node.bounds[2 * a + 1][c]), o[a]);
-                        // The lanes going down take the upper plane as the near one.
-                        let t_near = _mm512_mul_ps(_mm512_mask_blend_ps(down[a], lo, hi), inv[a]);
-                        let t_far = _mm512_mul_ps(_mm512_mask_blend_ps(down[a], hi, lo), inv_far[a]);
+                        let (t_near, t_far) = if same_way {
+                            let near = _mm512_set1_ps(node.bounds[2 * a + rows[a]][c]);
+                            let far = _mm512_set1_ps(node.bounds[2 * a + 1 - rows[a]][c]);
+                            (
+                                _mm512_mul_ps(_mm512_sub_ps(near, o[a]), inv[a]),
+                                _mm512_mul_ps(_mm512_sub_ps(far, o[a]), inv_far[a]),
+                            )
+                        } else {
+                            let lo = _mm512_sub_ps(_mm512_set1_ps(node.bounds[2 * a][c]), o[a]);
+                            let hi = _mm512_sub_ps(_mm512_set1_ps(node.bounds[2 * a + 1][c]), o[a]);
+                            // The lanes going down take the upper plane as the near one.
+                            (
+                                _mm512_mul_ps(_mm512_mask_blend_ps(down[a], lo, hi), inv[a]),
+                                _mm512_mul_ps(_mm512_mask_blend_ps(down[a], hi, lo), inv_far[a]),
+                            )
+                        };
                         // `max(a, b)` is `a > b ? a : b`, `b` when either is NaN: the scalar rule.
                         enter = _mm512_max_ps(t_near, enter);
                         exit = _mm512_min_ps(t_far, exit);
@@ -347,7 +369,7 @@ mod tests {
     use super::*;
     use crate::Aabb;
     use crate::accel::wide::isa::Isa;
-    use crate::accel::wide::node::{child_entry_scalar, reach};
+    use crate::accel::wide::node::{NodeRay, child_entry_scalar, reach};
 
     /// The kernel of `isa` on the packet, its lanes compared with the scalar packet kernel's, and
     /// those with the single-ray scalar test, bit for bit.

@@ -32,9 +32,14 @@ pub struct PacketTriRays {
 }
 
 impl PacketTriRays {
-    /// Prepares the rays of `active` (bit per ray of `rays`), or `None` if they do not all share
-    /// the watertight test's axes.
+    /// Prepares the rays of `active` (bit per ray of `rays`, at least one), or `None` if they do
+    /// not all share the watertight test's axes.
+    #[inline(always)]
     pub fn new(rays: &[Ray], active: u32) -> Option<Self> {
+        if active == 0 {
+            return None;
+        }
+        let axes = WatertightRay::axes_of(rays[active.trailing_zeros() as usize].dir());
         let zero = Lanes([0.0; PACKET]);
         let mut p = PacketTriRays {
             origin_k: [zero; 3],
@@ -42,27 +47,33 @@ impl PacketTriRays {
             inv_dir: [zero; 3],
             shear: [zero; 3],
             t_min: zero,
-            axes: [0; 3],
+            axes,
         };
-        let mut first = true;
+        // The directions on the shared axes; 1 along `kz` in the lanes left out, so that the
+        // divisions below stay finite there.
+        let (mut dx, mut dy, mut dz) = ([0.0f32; PACKET], [0.0f32; PACKET], [1.0f32; PACKET]);
         for (i, ray) in rays.iter().enumerate().take(PACKET) {
             if active >> i & 1 == 0 {
                 continue;
             }
-            let w = WatertightRay::new(ray);
-            if first {
-                (p.axes, first) = (w.axes(), false);
-            } else if w.axes() != p.axes {
+            let d = ray.dir();
+            if WatertightRay::axes_of(d) != axes {
                 return None;
             }
-            let (o, inv, s) = (ray.origin(), ray.inv_dir(), w.shear());
+            let (o, inv) = (ray.origin(), ray.inv_dir());
             for a in 0..3 {
-                p.origin_k[a].0[i] = o[p.axes[a]];
+                p.origin_k[a].0[i] = o[axes[a]];
                 p.origin[a].0[i] = o[a];
                 p.inv_dir[a].0[i] = inv[a];
-                p.shear[a].0[i] = s[a];
             }
+            (dx[i], dy[i], dz[i]) = (d[axes[0]], d[axes[1]], d[axes[2]]);
             p.t_min.0[i] = ray.t_min;
+        }
+        // The shear of `WatertightRay::new`, the same divisions lane by lane (one vector loop).
+        for i in 0..PACKET {
+            p.shear[0].0[i] = dx[i] / dz[i];
+            p.shear[1].0[i] = dy[i] / dz[i];
+            p.shear[2].0[i] = 1.0 / dz[i];
         }
         Some(p)
     }

@@ -18,13 +18,12 @@ use crate::accel::interface::batch::run_batch_chunks;
 use crate::accel::{BatchSizeMismatch, Counters, Hit, NoCount, NoFilter};
 use crate::{Aabb, Ray};
 
-/// The rays of a packet and their state: with AVX-512 and rays sharing the watertight test's
-/// axes, the packet's closest hits and triangle constants as structures of arrays (each triangle
-/// tested against the whole packet at once); otherwise each ray's single-ray leaf state.
+/// The rays of a packet and their closest hits so far, as structures of arrays. With AVX-512 and
+/// rays sharing the watertight test's axes, each triangle is tested against the whole packet at
+/// once; otherwise each ray's leaves are tested by the single-ray leaf test.
 struct TrianglePacket<'a> {
     rays: &'a [Ray],
     blocks: &'a [TriBlock],
-    lanes: [TriangleLeaves<'a, NoFilter>; PACKET],
     /// The shared-axes constants, when the packet's triangle tests run on whole packets;
     /// prepared at the first leaf (rays that reach none never pay for them).
     simd: Option<PacketTriRays>,
@@ -40,30 +39,10 @@ impl<'a> TrianglePacket<'a> {
     /// The leaf states of `rays` (at least one; lanes beyond them repeat the first and are never
     /// asked for), of which `active` will be traced.
     fn new(bvh: &'a TriangleBvh, rays: &'a [Ray], active: u32) -> Self {
-        let lanes = std::array::from_fn(|i| {
-            let source = rays.get(i).unwrap_or(&rays[0]);
-            TriangleLeaves {
-                blocks: bvh.blocks(),
-                source,
-                ray: None,
-                best: None,
-                t_max: source.t_max,
-                filter: NoFilter,
-            }
-        });
         let limits = Lanes(std::array::from_fn(|i| reach(rays.get(i).unwrap_or(&rays[0]).t_max)));
         // Only AVX-512 has the whole-packet triangle test.
         let decided = !(cfg!(target_arch = "x86_64") && bvh.isa() == Isa::Avx512);
-        TrianglePacket {
-            rays,
-            blocks: bvh.blocks(),
-            lanes,
-            simd: None,
-            decided,
-            active,
-            best: PacketBest::new(rays),
-            limits,
-        }
+        TrianglePacket { rays, blocks: bvh.blocks(), simd: None, decided, active, best: PacketBest::new(rays), limits }
     }
 
     /// The whole-packet triangle constants, if the packet's rays share their axes (see `simd`).
@@ -76,17 +55,21 @@ impl<'a> TrianglePacket<'a> {
         self.simd
     }
 
+    /// Ray `i`'s single-ray leaf state, its interval ending at its closest hit so far.
+    #[inline(always)]
+    fn lane(&self, i: usize) -> TriangleLeaves<'a, NoFilter> {
+        let source = &self.rays[i.min(self.rays.len() - 1)];
+        TriangleLeaves { blocks: self.blocks, source, ray: None, best: None, t_max: self.best.t.0[i], filter: NoFilter }
+    }
+
     /// The closest hit of ray `i`.
     fn hit(&self, i: usize) -> Option<Hit> {
-        if self.simd.is_none() {
-            // Per-ray leaves, or no leaf reached: `best` is each ray's own.
-            return self.lanes[i].best;
-        }
         let b = &self.best;
         (b.prim(i) != u32::MAX).then(|| Hit { t: b.t.0[i], prim: b.prim(i), u: b.u.0[i], v: b.v.0[i] })
     }
 
     /// Keeps `hit` as ray `i`'s closest if it is closer, or as close with a lower index.
+    #[inline(always)]
     fn offer(&mut self, i: usize, hit: Hit) {
         let b = &mut self.best;
         if hit.t < b.t.0[i] || (hit.t == b.t.0[i] && hit.prim < b.prim(i)) {
@@ -153,12 +136,17 @@ impl<C: Counters> PacketLeaves<C> for TrianglePacket<'_> {
             }
             return;
         }
+        // Ray by ray, each with the single-ray leaf test (the rays' triangle constants are
+        // prepared at each leaf: only packets whose rays went apart come here).
         while rays != 0 {
             let i = rays.trailing_zeros() as usize;
             rays &= rays - 1;
-            let lane = &mut self.lanes[i];
-            Leaves::<C>::closest(lane, first, count, counters);
-            self.limits.0[i] = reach(lane.t_max);
+            let mut lane = self.lane(i);
+            Leaves::<C>::closest(&mut lane, first, count, counters);
+            if let Some(hit) = lane.best {
+                self.offer(i, hit);
+            }
+            self.limits.0[i] = reach(self.best.t.0[i]);
         }
     }
 
@@ -172,7 +160,7 @@ impl<C: Counters> PacketLeaves<C> for TrianglePacket<'_> {
         while rays != 0 {
             let i = rays.trailing_zeros() as usize;
             rays &= rays - 1;
-            if Leaves::<C>::any(&mut self.lanes[i], first, count, counters) {
+            if Leaves::<C>::any(&mut self.lane(i), first, count, counters) {
                 found |= 1 << i;
             }
         }
@@ -186,7 +174,7 @@ impl<C: Counters> PacketLeaves<C> for TrianglePacket<'_> {
 
     #[inline(always)]
     fn prefetch(&self, first: u32) {
-        Leaves::<C>::prefetch(&self.lanes[0], first);
+        Leaves::<C>::prefetch(&self.lane(0), first);
     }
 }
 
