@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Instructions executed by a render's pixels, per structure, counted by callgrind: exact and
 # repeatable on a shared machine, where timings are not. Loading the scene and building the
-# structure are left out (only `Renderer::pixel` and what it calls are counted).
+# structure are left out (only `Renderer::pixel`, `Renderer::tile_in_packets` for primary rays
+# traced in packets, and what they call are counted).
 #
 #   scripts/render-instructions.sh [SCENE] [ACCEL,ACCEL...] [-- RENDER OPTIONS]
 #
@@ -21,7 +22,8 @@ trap 'rm -rf "$work"' EXIT
 first=""
 first_png=""
 for accel in ${accels//,/ }; do
-    valgrind --tool=callgrind --toggle-collect='*Renderer::pixel*' --callgrind-out-file="$work/$accel.out" \
+    valgrind --tool=callgrind --toggle-collect='*Renderer::pixel*' --toggle-collect='*Renderer::tile_in_packets*' \
+        --callgrind-out-file="$work/$accel.out" \
         ./target/release/englobe render "$scene" --threads 1 --accel "$accel" --quiet -o "$work/$accel.png" "$@" \
         2> "$work/$accel.log"
     count="$(sed -n 's/.*Collected : \([0-9]*\).*/\1/p' "$work/$accel.log")"

@@ -31,6 +31,7 @@ pub mod optics;
 pub mod output;
 mod passes;
 pub mod path;
+mod primary_packets;
 pub mod ray_cone;
 pub mod render;
 pub mod sampler;

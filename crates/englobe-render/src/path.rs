@@ -225,8 +225,25 @@ impl<'a> PathTracer<'a> {
         Some(Scatter { ray: Ray::new(s.outside(), dir), kind: RayKind::Bounce, weight: base, pdf })
     }
 
+    /// What decides which surfaces its rays see.
+    pub(crate) fn visibility(&self) -> &Visibility<'a> {
+        &self.vis
+    }
+
     /// One estimate of the radiance along the primary ray `ray`.
     pub fn radiance<C: Counters>(&self, ray: &Ray, rng: &mut impl Rng, tally: &mut Tally<C>) -> Vec3 {
+        self.radiance_from(ray, None, rng, tally)
+    }
+
+    /// [`PathTracer::radiance`] of a primary `ray` whose closest hit is `first` if it was found
+    /// already (by a packet of primary rays): `Some(hit)`, `hit` being `None` for a miss.
+    pub fn radiance_from<C: Counters>(
+        &self,
+        ray: &Ray,
+        mut first: Option<Option<WorldHit>>,
+        rng: &mut impl Rng,
+        tally: &mut Tally<C>,
+    ) -> Vec3 {
         let mut radiance = Vec3::ZERO;
         let mut throughput = Vec3::ONE;
         let mut ray = *ray;
@@ -235,7 +252,11 @@ impl<'a> PathTracer<'a> {
         let mut bounce_pdf: Option<f32> = None;
         for depth in 0..=self.scene.image.max_depth {
             tally.rays[kind as usize] += 1;
-            let Some(hit) = self.vis.closest_hit(&ray, &mut tally.work[kind as usize]) else {
+            let found = match first.take() {
+                Some(hit) => hit,
+                None => self.vis.closest_hit(&ray, &mut tally.work[kind as usize]),
+            };
+            let Some(hit) = found else {
                 radiance += throughput * self.lights.escaped(ray.dir(), bounce_pdf, self.scene.image.background);
                 break;
             };

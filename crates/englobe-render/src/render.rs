@@ -12,7 +12,7 @@
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::time::Instant;
 
-use englobe::{Counters, NoCount, Vec3, WorkCounts, World};
+use englobe::{Counters, NoCount, Ray, Vec3, WorkCounts, World};
 use englobe_scene::{ImageSettings, IntegratorKind, Scene, TextureFilter};
 use rand::RngExt;
 
@@ -221,6 +221,15 @@ impl<'a> Renderer<'a> {
                 let (x0, y0, x1, y1) = tile_at(index);
                 let mut tally = Tally::<C>::default();
                 let area = ((x1 - x0) * (y1 - y0)) as usize;
+                if self.primary_packets() {
+                    let pixels =
+                        self.tile_in_packets(&camera, &integrator, (x0, y0, x1, y1), &mut tally, &cancelled)?;
+                    let n = done.fetch_add(1, Ordering::Relaxed) + 1;
+                    if let Some(progress) = self.progress {
+                        progress(n, total);
+                    }
+                    return Some(TileOutput { pixels, stats: tally.stats(), cost: Vec::new() });
+                }
                 let mut pixels = Vec::with_capacity(area);
                 let mut cost = Vec::with_capacity(if self.record_cost { area } else { 0 });
                 for y in y0..y1 {
@@ -333,9 +342,36 @@ impl<'a> Renderer<'a> {
         tally: &mut Tally<C>,
     ) -> Vec3 {
         rng.start_sample();
-        let (dx, dy): (f32, f32) =
-            if self.samples == 1 { (0.5, 0.5) } else { self.filter.sample(rng.random(), rng.random()) };
+        let (dx, dy) = self.sample_offset(rng);
         self.sample_at(camera, integrator, x, y, dx, dy, rng, tally)
+    }
+
+    /// Where a sample passes through its pixel (see [`Renderer::sample`]), drawn from `rng` just
+    /// after [`PixelSampler::start_sample`].
+    #[inline]
+    pub(crate) fn sample_offset(&self, rng: &mut PixelSampler) -> (f32, f32) {
+        if self.samples == 1 { (0.5, 0.5) } else { self.filter.sample(rng.random(), rng.random()) }
+    }
+
+    /// The camera ray through the point `(dx, dy)` of pixel `(x, y)` (see
+    /// [`Renderer::sample_at`]).
+    #[inline]
+    pub(crate) fn camera_ray(
+        &self,
+        camera: &ImageCamera,
+        x: u32,
+        y: u32,
+        dx: f32,
+        dy: f32,
+        rng: &mut PixelSampler,
+    ) -> Ray {
+        if camera.has_lens() {
+            // Drawn only with a lens, so that pinhole images keep their random numbers.
+            let (u, v): (f32, f32) = (rng.random(), rng.random());
+            camera.ray_through_lens(x as f32 + dx, y as f32 + dy, u, v)
+        } else {
+            camera.ray(x as f32 + dx, y as f32 + dy)
+        }
     }
 
     /// The sample of pixel `(x, y)` through its point `(dx, dy)`, in pixels from its top-left
@@ -353,17 +389,17 @@ impl<'a> Renderer<'a> {
         rng: &mut PixelSampler,
         tally: &mut Tally<C>,
     ) -> Vec3 {
-        let ray = if camera.has_lens() {
-            // Drawn only with a lens, so that pinhole images keep their random numbers.
-            let (u, v): (f32, f32) = (rng.random(), rng.random());
-            camera.ray_through_lens(x as f32 + dx, y as f32 + dy, u, v)
-        } else {
-            camera.ray(x as f32 + dx, y as f32 + dy)
-        };
+        let ray = self.camera_ray(camera, x, y, dx, dy, rng);
         let radiance = match integrator {
             Integrator::Whitted(w) => w.radiance(&ray, tally),
             Integrator::Path(p) => p.radiance(&ray, rng, tally),
         };
+        self.clamped(radiance)
+    }
+
+    /// A sample's radiance clamped as the scene asks (see [`clamp_sample`]).
+    #[inline]
+    pub(crate) fn clamped(&self, radiance: Vec3) -> Vec3 {
         match self.scene.image.clamp {
             Some(most) => clamp_sample(radiance, most),
             None => radiance,

@@ -87,6 +87,20 @@ impl<'a> Visibility<'a> {
         }
     }
 
+    /// [`Visibility::closest_hit`] of each ray, `hits[i]` for `rays[i]`, the rays traced in
+    /// packets of sixteen (see [`World::closest_hit_packet`]) unless cut-outs need a filter. The
+    /// two slices are as long.
+    pub fn closest_hit_packet<C: Counters>(&self, rays: &[Ray], hits: &mut [Option<WorldHit>], counters: &mut C) {
+        debug_assert_eq!(rays.len(), hits.len());
+        if self.filtered {
+            for (h, r) in hits.iter_mut().zip(rays) {
+                *h = self.closest_hit(r, counters);
+            }
+        } else {
+            self.world.closest_hit_packet(rays, hits, counters).expect("as many places as rays");
+        }
+    }
+
     /// Whether a surface that is there lies within the ray's interval.
     #[inline]
     pub fn any_hit<C: Counters>(&self, ray: &Ray, counters: &mut C) -> bool {

@@ -23,7 +23,7 @@
 //! scene's `texture_filter = "cone"`, every ray carries a cone (see [`crate::ray_cone`]) that
 //! its reflections and refractions continue, and textures are read over its footprint.
 
-use englobe::{Counters, Ray, Vec3, World};
+use englobe::{Counters, Ray, Vec3, World, WorldHit};
 use englobe_scene::Scene;
 
 use crate::environment::EnvironmentLight;
@@ -61,9 +61,21 @@ impl<'a> Whitted<'a> {
         self
     }
 
+    /// What decides which surfaces its rays see.
+    pub(crate) fn visibility(&self) -> &Visibility<'a> {
+        &self.vis
+    }
+
     /// The colour seen along a primary `ray`.
     pub fn radiance<C: Counters>(&self, ray: &Ray, tally: &mut Tally<C>) -> Vec3 {
         self.trace(ray, RayKind::Primary, 0, 1.0, self.cone, tally)
+    }
+
+    /// [`Whitted::radiance`] of a primary `ray` whose closest hit, `hit`, was found already (by a
+    /// packet of primary rays).
+    pub fn radiance_from<C: Counters>(&self, ray: &Ray, hit: Option<WorldHit>, tally: &mut Tally<C>) -> Vec3 {
+        tally.rays[RayKind::Primary as usize] += 1;
+        self.shade(ray, hit, 0, 1.0, self.cone, tally)
     }
 
     /// The colour seen along `ray`, a ray of `kind` at recursion `depth` (0 for primary rays)
@@ -79,7 +91,21 @@ impl<'a> Whitted<'a> {
         tally: &mut Tally<C>,
     ) -> Vec3 {
         tally.rays[kind as usize] += 1;
-        let Some(hit) = self.vis.closest_hit(ray, &mut tally.work[kind as usize]) else {
+        let hit = self.vis.closest_hit(ray, &mut tally.work[kind as usize]);
+        self.shade(ray, hit, depth, weight, cone, tally)
+    }
+
+    /// The colour seen along `ray` (see [`Whitted::trace`]), whose closest hit is `hit`.
+    fn shade<C: Counters>(
+        &self,
+        ray: &Ray,
+        hit: Option<WorldHit>,
+        depth: u32,
+        weight: f32,
+        cone: Option<RayCone>,
+        tally: &mut Tally<C>,
+    ) -> Vec3 {
+        let Some(hit) = hit else {
             return self.environment.as_ref().map_or(self.scene.image.background, |e| e.radiance(ray.dir()));
         };
         let s = Surface::at_over(self.scene, self.world, ray, &hit, cone);

@@ -2,7 +2,8 @@
 //! batches that pick them against the single-ray queries (which the other tests check against
 //! brute force): the same answer for every ray, bit for bit, in every instruction set, for
 //! coherent packets (which take the whole-packet triangle test when their rays share axes) and
-//! incoherent ones, partial packets and invalid rays, rays through shared vertices and edges.
+//! incoherent ones, partial packets and invalid rays, rays through shared vertices and edges; and
+//! a [`World`]'s packets, whose rays go on alone through shapes, instances and planes.
 
 mod common;
 
@@ -12,7 +13,9 @@ use common::strategies::triangle;
 use englobe::accel::wide::Isa;
 use englobe::accel::wide::packet_kernels::PACKET;
 use englobe::accel::wide::triangle_packet::coherent;
-use englobe::{Hit, NoCount, Ray, TriangleBvh, Vec3, WorkCounts};
+use englobe::{
+    AccelKind, Affine3A, Hit, Instance, NoCount, Object, Plane, Ray, Sphere, TriangleBvh, Vec3, WorkCounts, World,
+};
 use proptest::prelude::*;
 
 /// Checks the packet queries and the batches of `bvh` against its single-ray queries on `rays`,
@@ -99,6 +102,38 @@ fn camera_and_shadow_packets_on_the_bunny() {
     }
     bvh.closest_hit_packet(&rays, &mut out, &mut packets).unwrap();
     assert!(packets.exact_tests >= single.exact_tests, "a packet tests the union of its rays' leaves");
+}
+
+#[test]
+fn world_packets_answer_as_single_rays_do() {
+    let bunny = std::sync::Arc::new(load_obj("scenes/meshes/bunny/stanford-bunny.obj"));
+    let b = bunny.bounds();
+    let objects: Vec<Object> = vec![
+        Object::Mesh(bunny.clone()),
+        Instance::new(bunny.clone(), Affine3A::from_translation(Vec3::X * b.extent().x * 1.1)).unwrap().into(),
+        Sphere::new(b.center() - Vec3::X * b.extent().x * 0.8, b.extent().y * 0.3).into(),
+        Plane::new(Vec3::Y, b.min - Vec3::Y * 1e-3).unwrap().into(),
+    ];
+    let world = World::build(objects, AccelKind::BvhWide).unwrap();
+    let eye = b.center() + Vec3::new(0.2, 0.4, 1.5) * b.extent().length();
+    let mut rays = camera(eye, b.center(), 50.0, 48);
+    rays[5] = Ray::new(eye, Vec3::ZERO);
+    let single: Vec<_> = rays.iter().map(|r| world.closest_hit(r, &mut NoCount)).collect();
+    let single_any: Vec<_> = rays.iter().map(|r| world.any_hit(r, &mut NoCount)).collect();
+    let (mut hits, mut batch) = (vec![None; rays.len()], vec![None; rays.len()]);
+    let (mut any, mut batch_any) = (vec![false; rays.len()], vec![false; rays.len()]);
+    world.closest_hit_packet(&rays, &mut hits, &mut WorkCounts::default()).unwrap();
+    world.any_hit_packet(&rays, &mut any, &mut NoCount).unwrap();
+    world.closest_hits(&rays, &mut batch).unwrap();
+    world.any_hits(&rays, &mut batch_any).unwrap();
+    assert_eq!(hits, single);
+    assert_eq!(batch, single);
+    assert_eq!(any, single_any);
+    assert_eq!(batch_any, single_any);
+    // Every kind of object is seen.
+    for object in 0..4 {
+        assert!(single.iter().flatten().any(|h| h.object == object), "object {object} never hit");
+    }
 }
 
 #[test]

@@ -1,15 +1,22 @@
-//! Batches of a [`World`]'s two queries over slices of rays: the single-ray queries, ray after
-//! ray, split across threads for large batches ([`crate::accel::interface::batch`]); no
-//! allocation per ray, the same answers as one ray at a time.
+//! Batches and packets of a [`World`]'s two queries over slices of rays. A packet of up to
+//! sixteen rays walks the meshes' triangle tree together ([`TriangleBvh::closest_hit_packet`]),
+//! then each ray goes on alone through the shapes, the instances and the planes, exactly as its
+//! single-ray query does after the meshes: the same answers, ray for ray. Batches take sixteen
+//! rays at a time, in a packet when they are coherent, split across threads when large
+//! ([`crate::accel::interface::batch`]); no allocation per ray.
+//!
+//! [`TriangleBvh::closest_hit_packet`]: crate::TriangleBvh::closest_hit_packet
 
 use super::{World, WorldHit};
 use crate::Ray;
-use crate::accel::interface::batch::run_batch;
-use crate::accel::{BatchSizeMismatch, NoCount};
+use crate::accel::interface::batch::run_batch_chunks;
+use crate::accel::wide::packet_kernels::PACKET;
+use crate::accel::wide::triangle_packet::coherent;
+use crate::accel::{BatchSizeMismatch, Counters, NoCount, NoFilter};
 
 impl World {
-    /// The closest hit of every ray, `hits[i]` for `rays[i]` ([`World::closest_hit`]). The two
-    /// slices must be as long.
+    /// The closest hit of every ray, `hits[i]` for `rays[i]` ([`World::closest_hit`]); sixteen
+    /// rays at a time, in a packet when they are coherent. The two slices must be as long.
     ///
     /// ```
     /// use englobe::{AccelKind, Ray, Sphere, Vec3, World};
@@ -23,12 +30,104 @@ impl World {
     /// # Ok::<(), Box<dyn std::error::Error>>(())
     /// ```
     pub fn closest_hits(&self, rays: &[Ray], hits: &mut [Option<WorldHit>]) -> Result<(), BatchSizeMismatch> {
-        run_batch(rays, hits, |r| self.closest_hit(r, &mut NoCount))
+        run_batch_chunks(rays, hits, PACKET, |rays, hits| {
+            if self.coherent(rays) {
+                self.closest_packet_of(rays, hits, &mut NoCount);
+            } else {
+                for (h, r) in hits.iter_mut().zip(rays) {
+                    *h = self.closest_hit(r, &mut NoCount);
+                }
+            }
+        })
     }
 
     /// Whether each ray hits anything within its interval, `mask[i]` for `rays[i]`
-    /// ([`World::any_hit`]). The two slices must be as long.
+    /// ([`World::any_hit`]); sixteen rays at a time, in a packet when they are coherent. The two
+    /// slices must be as long.
     pub fn any_hits(&self, rays: &[Ray], mask: &mut [bool]) -> Result<(), BatchSizeMismatch> {
-        run_batch(rays, mask, |r| self.any_hit(r, &mut NoCount))
+        run_batch_chunks(rays, mask, PACKET, |rays, mask| {
+            if self.coherent(rays) {
+                self.any_packet_of(rays, mask, &mut NoCount);
+            } else {
+                for (m, r) in mask.iter_mut().zip(rays) {
+                    *m = self.any_hit(r, &mut NoCount);
+                }
+            }
+        })
+    }
+
+    /// [`World::closest_hit`] of every ray, the meshes' triangles tested in packets of sixteen
+    /// consecutive rays (see the module documentation): for coherent rays, such as a camera's
+    /// in square tiles. The two slices must be as long.
+    pub fn closest_hit_packet<C: Counters>(
+        &self,
+        rays: &[Ray],
+        hits: &mut [Option<WorldHit>],
+        counters: &mut C,
+    ) -> Result<(), BatchSizeMismatch> {
+        if rays.len() != hits.len() {
+            return Err(BatchSizeMismatch { rays: rays.len(), outputs: hits.len() });
+        }
+        for (rays, hits) in rays.chunks(PACKET).zip(hits.chunks_mut(PACKET)) {
+            self.closest_packet_of(rays, hits, counters);
+        }
+        Ok(())
+    }
+
+    /// [`World::any_hit`] of every ray, in packets of sixteen (see
+    /// [`World::closest_hit_packet`]).
+    pub fn any_hit_packet<C: Counters>(
+        &self,
+        rays: &[Ray],
+        mask: &mut [bool],
+        counters: &mut C,
+    ) -> Result<(), BatchSizeMismatch> {
+        if rays.len() != mask.len() {
+            return Err(BatchSizeMismatch { rays: rays.len(), outputs: mask.len() });
+        }
+        for (rays, mask) in rays.chunks(PACKET).zip(mask.chunks_mut(PACKET)) {
+            self.any_packet_of(rays, mask, counters);
+        }
+        Ok(())
+    }
+
+    /// Whether `rays` are worth a packet: the world has meshes in its triangle tree, and the
+    /// rays are coherent at its scale.
+    fn coherent(&self, rays: &[Ray]) -> bool {
+        self.triangles.as_ref().is_some_and(|t| coherent(rays, &t.bounds()))
+    }
+
+    /// One packet of at most [`PACKET`] rays.
+    fn closest_packet_of<C: Counters>(&self, rays: &[Ray], hits: &mut [Option<WorldHit>], counters: &mut C) {
+        let mut meshes = [None; PACKET];
+        let meshes = &mut meshes[..rays.len()];
+        if let Some(t) = &self.triangles {
+            t.closest_hit_packet(rays, meshes, counters).expect("as many places as rays");
+        }
+        for ((h, ray), mesh) in hits.iter_mut().zip(rays).zip(meshes.iter()) {
+            *h = if ray.is_valid() {
+                self.closest_beyond_meshes(ray, mesh.map(|m| self.mesh_hit(m)), counters, &mut NoFilter)
+            } else {
+                None
+            };
+        }
+    }
+
+    /// One packet of at most [`PACKET`] rays: the unbounded shapes first, as [`World::any_hit`]
+    /// tests them, then the meshes for the rays still unblocked, then the rest.
+    fn any_packet_of<C: Counters>(&self, rays: &[Ray], mask: &mut [bool], counters: &mut C) {
+        for (m, ray) in mask.iter_mut().zip(rays) {
+            *m = ray.is_valid() && self.any_unbounded(ray, counters, &mut NoFilter);
+        }
+        if let Some(t) = &self.triangles {
+            let mut meshes = [false; PACKET];
+            t.any_hit_packet(rays, &mut meshes[..rays.len()], counters).expect("as many places as rays");
+            for (m, hit) in mask.iter_mut().zip(meshes) {
+                *m |= hit;
+            }
+        }
+        for (m, ray) in mask.iter_mut().zip(rays) {
+            *m = *m || (ray.is_valid() && self.any_in_accel(ray, counters, &mut NoFilter));
+        }
     }
 }

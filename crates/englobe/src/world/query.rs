@@ -100,16 +100,33 @@ impl World {
         if !ray.is_valid() {
             return None;
         }
-        let mut best = self
+        let best = self
             .triangles
             .as_ref()
             .and_then(|t| t.closest_hit_of_valid(ray, counters, Located { world: self, filter: &mut filter }))
-            .map(|h| {
-                let (object, prim) = self.locate(h.prim);
-                WorldHit { t: h.t, object, prim, u: h.u, v: h.v }
-            });
+            .map(|h| self.mesh_hit(h));
+        self.closest_beyond_meshes(ray, best, counters, &mut filter)
+    }
+
+    /// A hit on the meshes' triangle tree, as the world names it.
+    #[inline(always)]
+    pub(super) fn mesh_hit(&self, h: Hit) -> WorldHit {
+        let (object, prim) = self.locate(h.prim);
+        WorldHit { t: h.t, object, prim, u: h.u, v: h.v }
+    }
+
+    /// The closest hit of a valid `ray`, given `best`, the closest on the meshes' triangle tree:
+    /// the shapes and instances, then the unbounded shapes.
+    #[inline]
+    pub(super) fn closest_beyond_meshes<C: Counters, F: HitFilter<WorldHit>>(
+        &self,
+        ray: &Ray,
+        mut best: Option<WorldHit>,
+        counters: &mut C,
+        filter: &mut F,
+    ) -> Option<WorldHit> {
         if self.accel_in_use()
-            && let Some(hit) = self.accel_closest_hit(ray, best.map_or(ray.t_max, |b| b.t), counters, &mut filter)
+            && let Some(hit) = self.accel_closest_hit(ray, best.map_or(ray.t_max, |b| b.t), counters, filter)
             && beats(&hit, best.as_ref())
         {
             best = Some(hit);
@@ -189,7 +206,23 @@ impl World {
         if !ray.is_valid() {
             return false;
         }
-        let unbounded_hit = self.unbounded.iter().any(|&object| {
+        self.any_unbounded(ray, counters, &mut filter)
+            || self
+                .triangles
+                .as_ref()
+                .is_some_and(|t| t.any_hit_of_valid(ray, counters, Located { world: self, filter: &mut filter }))
+            || self.any_in_accel(ray, counters, &mut filter)
+    }
+
+    /// Whether a valid `ray` hits one of the unbounded shapes (planes).
+    #[inline]
+    pub(super) fn any_unbounded<C: Counters, F: HitFilter<WorldHit>>(
+        &self,
+        ray: &Ray,
+        counters: &mut C,
+        filter: &mut F,
+    ) -> bool {
+        self.unbounded.iter().any(|&object| {
             counters.exact_test();
             match &self.objects[object as usize] {
                 Object::Shape(s) => s.intersect(ray).is_some_and(|h| {
@@ -197,15 +230,17 @@ impl World {
                 }),
                 Object::Mesh(_) | Object::Instance(_) => false,
             }
-        });
-        if unbounded_hit
-            || self
-                .triangles
-                .as_ref()
-                .is_some_and(|t| t.any_hit_of_valid(ray, counters, Located { world: self, filter: &mut filter }))
-        {
-            return true;
-        }
+        })
+    }
+
+    /// Whether a valid `ray` hits one of the primitives of [`World::accel`] (shapes, instances).
+    #[inline]
+    pub(super) fn any_in_accel<C: Counters, F: HitFilter<WorldHit>>(
+        &self,
+        ray: &Ray,
+        counters: &mut C,
+        filter: &mut F,
+    ) -> bool {
         if !self.accel_in_use() {
             return false;
         }
@@ -218,7 +253,7 @@ impl World {
                 Object::Mesh(m) => {
                     m.intersect_with(local, r, watertight.get_or_insert_with(|| WatertightRay::new(ray)))
                 }
-                Object::Instance(inst) => return self.instance_any_hit(object, inst, r, &mut nested, &mut filter),
+                Object::Instance(inst) => return self.instance_any_hit(object, inst, r, &mut nested, filter),
             };
             h.is_some_and(|h| {
                 F::ACCEPTS_ALL || filter.accept(&WorldHit { t: h.t, object, prim: local, u: h.u, v: h.v })
