@@ -27,7 +27,9 @@ impl Renderer<'_> {
     }
 
     /// The pixels of the tile `(x0, y0)..(x1, y1)`, row by row, primary rays traced in packets;
-    /// `None` if `cancelled` says so between two packets.
+    /// `None` if `cancelled` says so between two packets. Not inlined, so that profiles (and
+    /// `scripts/render-instructions.sh`) find it by name.
+    #[inline(never)]
     pub(crate) fn tile_in_packets<C: Counters>(
         &self,
         camera: &ImageCamera,

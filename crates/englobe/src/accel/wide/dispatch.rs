@@ -15,25 +15,26 @@ use super::traverse::{self, Leaves};
 use crate::accel::Counters;
 
 /// The closest-hit traversal compiled for `isa`, which the processor must have (see the module
-/// documentation).
+/// documentation), from node `start` (0, the root, for a whole query).
 #[inline(always)]
 pub fn closest<C: Counters, L: Leaves<C>>(
     isa: Isa,
     nodes: &[WideNode],
     depth: u32,
+    start: u32,
     ray: &NodeRay,
     leaves: &mut L,
     counters: &mut C,
 ) {
     debug_assert!(isa.is_available());
     match isa {
-        Isa::Portable => portable::closest(nodes, depth, ray, leaves, counters),
+        Isa::Portable => portable::closest(nodes, depth, start, ray, leaves, counters),
         // SAFETY: the structure's instruction set is one the processor has (module documentation).
         #[cfg(target_arch = "x86_64")]
-        Isa::Avx2 => unsafe { x86::closest_avx2(nodes, depth, ray, leaves, counters) },
+        Isa::Avx2 => unsafe { x86::closest_avx2(nodes, depth, start, ray, leaves, counters) },
         // SAFETY: as above.
         #[cfg(target_arch = "x86_64")]
-        Isa::Avx512 => unsafe { x86::closest_avx512(nodes, depth, ray, leaves, counters) },
+        Isa::Avx512 => unsafe { x86::closest_avx512(nodes, depth, start, ray, leaves, counters) },
         #[cfg(not(target_arch = "x86_64"))]
         _ => unreachable!("x86 instruction sets are never available elsewhere"),
     }
@@ -45,6 +46,7 @@ pub fn any<C: Counters, L: Leaves<C>>(
     isa: Isa,
     nodes: &[WideNode],
     depth: u32,
+    start: u32,
     ray: &NodeRay,
     limit: f32,
     leaves: &mut L,
@@ -52,13 +54,13 @@ pub fn any<C: Counters, L: Leaves<C>>(
 ) -> bool {
     debug_assert!(isa.is_available());
     match isa {
-        Isa::Portable => portable::any(nodes, depth, ray, limit, leaves, counters),
+        Isa::Portable => portable::any(nodes, depth, start, ray, limit, leaves, counters),
         // SAFETY: the structure's instruction set is one the processor has (module documentation).
         #[cfg(target_arch = "x86_64")]
-        Isa::Avx2 => unsafe { x86::any_avx2(nodes, depth, ray, limit, leaves, counters) },
+        Isa::Avx2 => unsafe { x86::any_avx2(nodes, depth, start, ray, limit, leaves, counters) },
         // SAFETY: as above.
         #[cfg(target_arch = "x86_64")]
-        Isa::Avx512 => unsafe { x86::any_avx512(nodes, depth, ray, limit, leaves, counters) },
+        Isa::Avx512 => unsafe { x86::any_avx512(nodes, depth, start, ray, limit, leaves, counters) },
         #[cfg(not(target_arch = "x86_64"))]
         _ => unreachable!("x86 instruction sets are never available elsewhere"),
     }
@@ -123,25 +125,27 @@ mod portable {
     pub fn closest<C: Counters, L: Leaves<C>>(
         nodes: &[WideNode],
         depth: u32,
+        start: u32,
         ray: &NodeRay,
         leaves: &mut L,
         counters: &mut C,
     ) {
         // SAFETY: the portable kernel needs nothing beyond the target's baseline.
-        unsafe { traverse::closest(Portable, nodes, depth, ray, leaves, counters) }
+        unsafe { traverse::closest(Portable, nodes, depth, start, ray, leaves, counters) }
     }
 
     #[inline(never)]
     pub fn any<C: Counters, L: Leaves<C>>(
         nodes: &[WideNode],
         depth: u32,
+        start: u32,
         ray: &NodeRay,
         limit: f32,
         leaves: &mut L,
         counters: &mut C,
     ) -> bool {
         // SAFETY: as above.
-        unsafe { traverse::any(Portable, nodes, depth, ray, limit, leaves, counters) }
+        unsafe { traverse::any(Portable, nodes, depth, start, ray, limit, leaves, counters) }
     }
 
     #[inline(never)]
@@ -181,12 +185,13 @@ mod x86 {
     pub unsafe fn closest_avx2<C: Counters, L: Leaves<C>>(
         nodes: &[WideNode],
         depth: u32,
+        start: u32,
         ray: &NodeRay,
         leaves: &mut L,
         counters: &mut C,
     ) {
         // SAFETY: compiled with AVX2, which the caller guarantees.
-        unsafe { traverse::closest(Avx2, nodes, depth, ray, leaves, counters) }
+        unsafe { traverse::closest(Avx2, nodes, depth, start, ray, leaves, counters) }
     }
 
     /// # Safety
@@ -195,12 +200,13 @@ mod x86 {
     pub unsafe fn closest_avx512<C: Counters, L: Leaves<C>>(
         nodes: &[WideNode],
         depth: u32,
+        start: u32,
         ray: &NodeRay,
         leaves: &mut L,
         counters: &mut C,
     ) {
         // SAFETY: compiled with AVX-512, which the caller guarantees.
-        unsafe { traverse::closest(Avx512, nodes, depth, ray, leaves, counters) }
+        unsafe { traverse::closest(Avx512, nodes, depth, start, ray, leaves, counters) }
     }
 
     /// # Safety
@@ -209,13 +215,14 @@ mod x86 {
     pub unsafe fn any_avx2<C: Counters, L: Leaves<C>>(
         nodes: &[WideNode],
         depth: u32,
+        start: u32,
         ray: &NodeRay,
         limit: f32,
         leaves: &mut L,
         counters: &mut C,
     ) -> bool {
         // SAFETY: compiled with AVX2, which the caller guarantees.
-        unsafe { traverse::any(Avx2, nodes, depth, ray, limit, leaves, counters) }
+        unsafe { traverse::any(Avx2, nodes, depth, start, ray, limit, leaves, counters) }
     }
 
     /// # Safety
@@ -224,13 +231,14 @@ mod x86 {
     pub unsafe fn any_avx512<C: Counters, L: Leaves<C>>(
         nodes: &[WideNode],
         depth: u32,
+        start: u32,
         ray: &NodeRay,
         limit: f32,
         leaves: &mut L,
         counters: &mut C,
     ) -> bool {
         // SAFETY: compiled with AVX-512, which the caller guarantees.
-        unsafe { traverse::any(Avx512, nodes, depth, ray, limit, leaves, counters) }
+        unsafe { traverse::any(Avx512, nodes, depth, start, ray, limit, leaves, counters) }
     }
 
     /// # Safety

@@ -189,7 +189,7 @@ impl Accel for WideBvh {
             return None;
         }
         let mut leaves = ClosureLeaves { prims: &self.prim_indices, record: HitRecord::new(*ray), test: intersect };
-        dispatch::closest(self.isa, &self.nodes, self.depth, &NodeRay::new(ray), &mut leaves, counters);
+        dispatch::closest(self.isa, &self.nodes, self.depth, 0, &NodeRay::new(ray), &mut leaves, counters);
         leaves.record.hit
     }
 
@@ -200,7 +200,7 @@ impl Accel for WideBvh {
         }
         let test = |prim: u32, r: &Ray| occludes(prim, r).then_some(PrimHit::at(0.0));
         let mut leaves = ClosureLeaves { prims: &self.prim_indices, record: HitRecord::new(*ray), test };
-        dispatch::any(self.isa, &self.nodes, self.depth, &NodeRay::new(ray), reach(ray.t_max), &mut leaves, counters)
+        dispatch::any(self.isa, &self.nodes, self.depth, 0, &NodeRay::new(ray), reach(ray.t_max), &mut leaves, counters)
     }
 
     fn stats(&self) -> StructureStats {

@@ -8,7 +8,8 @@
 //!
 //! Coherent rays (a camera's, shadow rays of neighbouring points towards one light) visit nearly
 //! the same nodes, so the packet pays for a node once instead of once per ray. Incoherent rays
-//! visit the union of their paths: single-ray queries suit them better.
+//! visit the union of their paths: single-ray queries suit them better, and a packet thinned to
+//! a couple of rays lets them go on alone, as Embree's hybrid traversal does.
 //!
 //! A ray's answer does not depend on its companions: it enters exactly the boxes its own query
 //! enters (the same slab test, lane by lane), and its leaves are tested by the single-ray leaf
@@ -46,7 +47,15 @@ pub trait PacketLeaves<C: Counters> {
     fn limits(&self) -> &Lanes;
     /// Starts loading the first item from `first` into the cache (a hint).
     fn prefetch(&self, first: u32);
+    /// Walks the subtree of the interior node `reference` with each ray of `rays` alone (the
+    /// single-ray traversal), for the closest hit or, without `closest`, any hit; returns the
+    /// rays that hit something (any hit only).
+    fn alone(&mut self, reference: u32, rays: u32, closest: bool, counters: &mut C) -> u32;
 }
+
+/// Rays at most that go on alone rather than as a packet: a node test costs the packet about as
+/// much as three rays' own tests.
+const ALONE: u32 = 2;
 
 /// Whether a packet query can run on a tree of depth `depth` (its stack lives on the call stack;
 /// deeper trees, which only degenerate builds make, are walked one ray at a time).
@@ -134,6 +143,14 @@ unsafe fn walk<K: PacketKernel, C: Counters, L: PacketLeaves<C>>(
                 leaves.closest(index_of(reference), count, current, counters);
             } else {
                 alive &= !leaves.any(index_of(reference), count, current, counters);
+                if alive == 0 {
+                    return 0;
+                }
+            }
+        } else if current.count_ones() <= ALONE {
+            let found = leaves.alone(reference, current, closest, counters);
+            if !closest {
+                alive &= !found;
                 if alive == 0 {
                     return 0;
                 }

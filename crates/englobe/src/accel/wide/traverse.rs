@@ -137,8 +137,8 @@ fn give_back(deep: Vec<MaybeUninit<Entry>>) {
     }
 }
 
-/// The closest hit: walks the tree from the root (node 0 of a non-empty `nodes`), asking `leaves`
-/// to test the leaves the ray reaches, nearest first.
+/// The closest hit: walks the tree from node `start` (0, the root, for a whole query), asking
+/// `leaves` to test the leaves the ray reaches, nearest first.
 ///
 /// # Safety
 /// As [`NodeKernel::children`]: compiled with the kernel's target features, run on a processor
@@ -149,6 +149,7 @@ pub unsafe fn closest<K: NodeKernel, C: Counters, L: Leaves<C>>(
     kernel: K,
     nodes: &[WideNode],
     depth: u32,
+    start: u32,
     ray: &NodeRay,
     leaves: &mut L,
     counters: &mut C,
@@ -158,7 +159,7 @@ pub unsafe fn closest<K: NodeKernel, C: Counters, L: Leaves<C>>(
     let stack = stack_for(depth, &mut inline, &mut deep);
     let mut len = 0usize;
     let mut dist = [0.0f32; WIDTH];
-    let mut current = Entry { reference: 0, count: 0, t: 0.0 };
+    let mut current = Entry { reference: start, count: 0, t: 0.0 };
     'walk: loop {
         {
             if is_leaf(current.reference) {
@@ -241,7 +242,7 @@ pub unsafe fn closest<K: NodeKernel, C: Counters, L: Leaves<C>>(
     give_back(deep);
 }
 
-/// Whether any leaf item is hit: stops at the first one `leaves` reports.
+/// Whether any leaf item is hit, from node `start`: stops at the first one `leaves` reports.
 ///
 /// # Safety
 /// As [`closest`].
@@ -250,6 +251,7 @@ pub unsafe fn any<K: NodeKernel, C: Counters, L: Leaves<C>>(
     kernel: K,
     nodes: &[WideNode],
     depth: u32,
+    start: u32,
     ray: &NodeRay,
     limit: f32,
     leaves: &mut L,
@@ -260,7 +262,7 @@ pub unsafe fn any<K: NodeKernel, C: Counters, L: Leaves<C>>(
     let stack = stack_for(depth, &mut inline, &mut deep);
     let mut len = 0usize;
     let mut dist = [0.0f32; WIDTH];
-    let mut current = Entry { reference: 0, count: 0, t: 0.0 };
+    let mut current = Entry { reference: start, count: 0, t: 0.0 };
     let hit = 'walk: loop {
         {
             if is_leaf(current.reference) {

@@ -283,7 +283,7 @@ impl TriangleBvh {
         }
         let mut leaves =
             TriangleLeaves { blocks: &self.blocks, source: ray, ray: None, best: None, t_max: ray.t_max, filter };
-        dispatch::closest(self.isa, &self.nodes, self.depth, &NodeRay::new(ray), &mut leaves, counters);
+        dispatch::closest(self.isa, &self.nodes, self.depth, 0, &NodeRay::new(ray), &mut leaves, counters);
         leaves.best
     }
 
@@ -312,7 +312,7 @@ impl TriangleBvh {
         }
         let mut leaves =
             TriangleLeaves { blocks: &self.blocks, source: ray, ray: None, best: None, t_max: ray.t_max, filter };
-        dispatch::any(self.isa, &self.nodes, self.depth, &NodeRay::new(ray), reach(ray.t_max), &mut leaves, counters)
+        dispatch::any(self.isa, &self.nodes, self.depth, 0, &NodeRay::new(ray), reach(ray.t_max), &mut leaves, counters)
     }
 
     /// Size and shape: wide nodes, leaves, depth, stored triangles and bytes. The leaf sizes count

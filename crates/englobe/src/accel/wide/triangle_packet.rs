@@ -5,7 +5,7 @@
 
 use super::dispatch;
 use super::isa::Isa;
-use super::node::reach;
+use super::node::{NodeRay, reach};
 use super::packet::{self, PacketLeaves};
 use super::packet_kernels::{Lanes, PACKET, PacketRays};
 #[cfg(target_arch = "x86_64")]
@@ -23,6 +23,7 @@ use crate::{Aabb, Ray};
 /// once; otherwise each ray's leaves are tested by the single-ray leaf test.
 struct TrianglePacket<'a> {
     rays: &'a [Ray],
+    bvh: &'a TriangleBvh,
     blocks: &'a [TriBlock],
     /// The shared-axes constants, when the packet's triangle tests run on whole packets;
     /// prepared at the first leaf (rays that reach none never pay for them).
@@ -42,7 +43,16 @@ impl<'a> TrianglePacket<'a> {
         let limits = Lanes(std::array::from_fn(|i| reach(rays.get(i).unwrap_or(&rays[0]).t_max)));
         // Only AVX-512 has the whole-packet triangle test.
         let decided = !(cfg!(target_arch = "x86_64") && bvh.isa() == Isa::Avx512);
-        TrianglePacket { rays, blocks: bvh.blocks(), simd: None, decided, active, best: PacketBest::new(rays), limits }
+        TrianglePacket {
+            rays,
+            bvh,
+            blocks: bvh.blocks(),
+            simd: None,
+            decided,
+            active,
+            best: PacketBest::new(rays),
+            limits,
+        }
     }
 
     /// The whole-packet triangle constants, if the packet's rays share their axes (see `simd`).
@@ -175,6 +185,33 @@ impl<C: Counters> PacketLeaves<C> for TrianglePacket<'_> {
     #[inline(always)]
     fn prefetch(&self, first: u32) {
         Leaves::<C>::prefetch(&self.lane(0), first);
+    }
+
+    #[inline(never)]
+    fn alone(&mut self, reference: u32, mut rays: u32, closest: bool, counters: &mut C) -> u32 {
+        let bvh = self.bvh;
+        let mut found = 0;
+        while rays != 0 {
+            let i = rays.trailing_zeros() as usize;
+            rays &= rays - 1;
+            let source = &self.rays[i];
+            let node_ray = NodeRay::new(source);
+            let mut lane = self.lane(i);
+            if closest {
+                dispatch::closest(bvh.isa(), bvh.nodes(), bvh.depth(), reference, &node_ray, &mut lane, counters);
+                if let Some(hit) = lane.best {
+                    self.offer(i, hit);
+                }
+                self.limits.0[i] = reach(self.best.t.0[i]);
+            } else {
+                let limit = reach(source.t_max);
+                if dispatch::any(bvh.isa(), bvh.nodes(), bvh.depth(), reference, &node_ray, limit, &mut lane, counters)
+                {
+                    found |= 1 << i;
+                }
+            }
+        }
+        found
     }
 }
 
