@@ -42,6 +42,7 @@ pub fn closest<C: Counters, L: Leaves<C>>(
 
 /// The any-hit traversal compiled for `isa` (see [`closest`]).
 #[inline(always)]
+#[allow(clippy::too_many_arguments)]
 pub fn any<C: Counters, L: Leaves<C>>(
     isa: Isa,
     nodes: &[WideNode],

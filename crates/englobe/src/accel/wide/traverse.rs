@@ -247,6 +247,7 @@ pub unsafe fn closest<K: NodeKernel, C: Counters, L: Leaves<C>>(
 /// # Safety
 /// As [`closest`].
 #[inline(always)]
+#[allow(clippy::too_many_arguments)]
 pub unsafe fn any<K: NodeKernel, C: Counters, L: Leaves<C>>(
     kernel: K,
     nodes: &[WideNode],
