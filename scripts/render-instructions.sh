@@ -22,7 +22,7 @@ trap 'rm -rf "$work"' EXIT
 first=""
 first_png=""
 for accel in ${accels//,/ }; do
-    valgrind --tool=callgrind --toggle-collect='*Renderer::pixel*' --toggle-collect='*Renderer::tile_in_packets*' \
+    valgrind --tool=callgrind --toggle-collect='*Renderer::pixel*' --toggle-collect='*::tile_in_packets*' \
         --callgrind-out-file="$work/$accel.out" \
         ./target/release/englobe render "$scene" --threads 1 --accel "$accel" --quiet -o "$work/$accel.png" "$@" \
         2> "$work/$accel.log"

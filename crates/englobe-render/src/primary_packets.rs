@@ -21,9 +21,14 @@ const BLOCK: u32 = 4;
 const PACKET: usize = (BLOCK * BLOCK) as usize;
 
 impl Renderer<'_> {
-    /// Whether this render traces its primary rays in packets (see the module documentation).
+    /// Whether this render traces its primary rays in packets (see the module documentation):
+    /// only worlds whose meshes are in the fast path's triangle tree have something to gain.
     pub(crate) fn primary_packets(&self) -> bool {
-        !self.count_work && !self.record_cost && self.supersampling.is_none() && self.stride == 1
+        !self.count_work
+            && !self.record_cost
+            && self.supersampling.is_none()
+            && self.stride == 1
+            && self.world.triangles().is_some()
     }
 
     /// The pixels of the tile `(x0, y0)..(x1, y1)`, row by row, primary rays traced in packets;
