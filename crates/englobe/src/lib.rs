@@ -57,7 +57,10 @@
 //! ## Batches
 //!
 //! A slice of rays in, a slice of answers out, split across threads when the batch is large
-//! (the `parallel` feature), nothing allocated per ray.
+//! (the `parallel` feature), nothing allocated per ray. Sixteen consecutive rays that are
+//! coherent (a camera's tile, a lidar's fan) walk the tree together as a packet; the others go
+//! one by one. `closest_hit_packet` and `any_hit_packet` ask for packets whatever the rays. Every
+//! ray gets its single-ray answer, bit for bit.
 //!
 //! ```
 //! # use englobe::{NoCount, Ray, TriangleBvh, Vec3};

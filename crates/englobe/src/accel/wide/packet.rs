@@ -1,6 +1,7 @@
-//! Packet traversal of the wide BVH: up to [`PACKET`] rays walk the tree together, each node's
-//! children tested against all of them at once ([`super::packet_kernels`]), each child entered by
-//! the rays that enter its box and only by them. This is the packet traversal of Wald, Slusallek,
+//! Packet traversal of the wide BVH: up to sixteen rays
+//! ([`PACKET`](super::packet_kernels::PACKET)) walk the tree together, each node's children
+//! tested against all of them at once ([`super::packet_kernels`]), each child entered by the rays
+//! that enter its box and only by them. This is the packet traversal of Wald, Slusallek,
 //! Benthin and Wagner (2001), "Interactive Rendering with Coherent Ray Tracing", with the active
 //! mask and per-ray entry distances of Embree's hybrid traversal (Wald et al. 2014): a stack entry
 //! keeps each ray's distance into the child, so that a ray which has found a closer hit since the
