@@ -142,14 +142,7 @@ fn vertical_packets_through_shared_vertices_and_edges() {
     // the whole-packet triangle test runs) through its vertices and edges, with zero components of
     // both signs: edge functions of exactly zero, which the scalar test must decide.
     let n = 12;
-    let p = |i: usize, j: usize| Vec3::new(i as f32, j as f32, ((i + j) % 3) as f32 * 0.5);
-    let mut tris = Vec::new();
-    for i in 0..n {
-        for j in 0..n {
-            tris.push([p(i, j), p(i + 1, j), p(i + 1, j + 1)]);
-            tris.push([p(i, j), p(i + 1, j + 1), p(i, j + 1)]);
-        }
-    }
+    let tris = common::folded_grid(n);
     let mut bvh = TriangleBvh::from_triangles(&tris);
     let mut rays = Vec::new();
     for d in [Vec3::new(0.0, -0.0, -1.0), Vec3::new(-0.0, 0.0, -1.0), Vec3::new(0.125, 0.25, -1.0)] {

@@ -121,14 +121,7 @@ fn axis_parallel_rays_through_shared_vertices_and_edges() {
     // A folded grid of triangles sharing edges and vertices, with integer coordinates: rays along
     // the axes through vertices and edges hit exactly on them.
     let n = 12;
-    let p = |i: usize, j: usize| Vec3::new(i as f32, j as f32, ((i + j) % 3) as f32 * 0.5);
-    let mut tris = Vec::new();
-    for i in 0..n {
-        for j in 0..n {
-            tris.push([p(i, j), p(i + 1, j), p(i + 1, j + 1)]);
-            tris.push([p(i, j), p(i + 1, j + 1), p(i, j + 1)]);
-        }
-    }
+    let tris = common::folded_grid(n);
     let mut rays = Vec::new();
     for i in 0..=2 * n {
         for j in 0..=2 * n {

@@ -9,7 +9,7 @@
 
 use super::{World, WorldHit};
 use crate::Ray;
-use crate::accel::interface::batch::run_batch_chunks;
+use crate::accel::interface::batch::{run_batch_chunks, run_packets};
 use crate::accel::wide::packet_kernels::PACKET;
 use crate::accel::wide::triangle_packet::coherent;
 use crate::accel::{BatchSizeMismatch, Counters, NoCount, NoFilter};
@@ -65,13 +65,7 @@ impl World {
         hits: &mut [Option<WorldHit>],
         counters: &mut C,
     ) -> Result<(), BatchSizeMismatch> {
-        if rays.len() != hits.len() {
-            return Err(BatchSizeMismatch { rays: rays.len(), outputs: hits.len() });
-        }
-        for (rays, hits) in rays.chunks(PACKET).zip(hits.chunks_mut(PACKET)) {
-            self.closest_packet_of(rays, hits, counters);
-        }
-        Ok(())
+        run_packets(rays, hits, PACKET, |rays, hits| self.closest_packet_of(rays, hits, counters))
     }
 
     /// [`World::any_hit`] of every ray, in packets of sixteen (see
@@ -82,13 +76,7 @@ impl World {
         mask: &mut [bool],
         counters: &mut C,
     ) -> Result<(), BatchSizeMismatch> {
-        if rays.len() != mask.len() {
-            return Err(BatchSizeMismatch { rays: rays.len(), outputs: mask.len() });
-        }
-        for (rays, mask) in rays.chunks(PACKET).zip(mask.chunks_mut(PACKET)) {
-            self.any_packet_of(rays, mask, counters);
-        }
-        Ok(())
+        run_packets(rays, mask, PACKET, |rays, mask| self.any_packet_of(rays, mask, counters))
     }
 
     /// Whether `rays` are worth a packet: the world has meshes in its triangle tree, and the

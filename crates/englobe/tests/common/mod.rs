@@ -142,3 +142,18 @@ pub fn load_obj(relative: &str) -> TriangleMesh {
     }
     TriangleMesh::new(positions, triangles).expect("a valid mesh")
 }
+
+/// A folded `n` x `n` grid of triangles sharing edges and vertices, with integer coordinates in
+/// x and y and heights of 0, 0.5 and 1: rays along the axes through its vertices and edges hit
+/// exactly on them.
+pub fn folded_grid(n: usize) -> Vec<[Vec3; 3]> {
+    let p = |i: usize, j: usize| Vec3::new(i as f32, j as f32, ((i + j) % 3) as f32 * 0.5);
+    let mut tris = Vec::new();
+    for i in 0..n {
+        for j in 0..n {
+            tris.push([p(i, j), p(i + 1, j), p(i + 1, j + 1)]);
+            tris.push([p(i, j), p(i + 1, j + 1), p(i, j + 1)]);
+        }
+    }
+    tris
+}

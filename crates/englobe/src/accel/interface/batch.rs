@@ -77,3 +77,20 @@ pub fn run_batch_chunks<T: Send>(
     run(out, rays);
     Ok(())
 }
+
+/// Calls `query` on consecutive pieces of `rays` and `out`, `width` rays at a time (the last
+/// piece perhaps shorter), on the calling thread: the packet queries' loop.
+pub fn run_packets<T>(
+    rays: &[Ray],
+    out: &mut [T],
+    width: usize,
+    mut query: impl FnMut(&[Ray], &mut [T]),
+) -> Result<(), BatchSizeMismatch> {
+    if rays.len() != out.len() {
+        return Err(BatchSizeMismatch { rays: rays.len(), outputs: out.len() });
+    }
+    for (rays, out) in rays.chunks(width).zip(out.chunks_mut(width)) {
+        query(rays, out);
+    }
+    Ok(())
+}

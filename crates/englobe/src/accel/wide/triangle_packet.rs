@@ -14,7 +14,7 @@ use super::packet_triangles::{PacketBest, PacketTriRays};
 use super::traverse::Leaves;
 use super::triangle_bvh::{TriangleBvh, TriangleLeaves};
 use super::triangles::{TriBlock, TriRay};
-use crate::accel::interface::batch::run_batch_chunks;
+use crate::accel::interface::batch::{run_batch_chunks, run_packets};
 use crate::accel::{BatchSizeMismatch, Counters, Hit, NoCount, NoFilter};
 use crate::{Aabb, Ray};
 
@@ -253,13 +253,7 @@ impl TriangleBvh {
         hits: &mut [Option<Hit>],
         counters: &mut C,
     ) -> Result<(), BatchSizeMismatch> {
-        if rays.len() != hits.len() {
-            return Err(BatchSizeMismatch { rays: rays.len(), outputs: hits.len() });
-        }
-        for (rays, hits) in rays.chunks(PACKET).zip(hits.chunks_mut(PACKET)) {
-            self.closest_packet_of(rays, hits, counters);
-        }
-        Ok(())
+        run_packets(rays, hits, PACKET, |rays, hits| self.closest_packet_of(rays, hits, counters))
     }
 
     /// Whether each ray hits anything, `mask[i]` for `rays[i]`, in packets of sixteen (see
@@ -270,13 +264,7 @@ impl TriangleBvh {
         mask: &mut [bool],
         counters: &mut C,
     ) -> Result<(), BatchSizeMismatch> {
-        if rays.len() != mask.len() {
-            return Err(BatchSizeMismatch { rays: rays.len(), outputs: mask.len() });
-        }
-        for (rays, mask) in rays.chunks(PACKET).zip(mask.chunks_mut(PACKET)) {
-            self.any_packet_of(rays, mask, counters);
-        }
-        Ok(())
+        run_packets(rays, mask, PACKET, |rays, mask| self.any_packet_of(rays, mask, counters))
     }
 
     /// The closest hit of every ray (see [`TriangleBvh::closest_hit`]), on several threads for
