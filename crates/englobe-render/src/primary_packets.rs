@@ -6,7 +6,8 @@
 //! Every pixel keeps its own random numbers, drawn in the same order, and every ray its own
 //! closest hit, so the image is bit for bit the one a pixel-by-pixel render makes. What changes is
 //! the work counts (a packet visits the union of its rays' nodes), so renders that count their
-//! work, record a cost image, sample adaptively or skip pixels go pixel by pixel.
+//! work, record a cost image, sample adaptively or skip pixels go pixel by pixel; so do worlds
+//! without a triangle tree (the teaching structures, instances alone), which have nothing to gain.
 
 use englobe::{Counters, Ray, Vec3, WorldHit};
 

@@ -1,5 +1,7 @@
 //! Packets of rays on [`TriangleBvh`]: up to [`PACKET`] rays walk the tree together (see
-//! [`super::packet`]), each ray's leaves tested by the single-ray block test, so that every ray
+//! [`super::packet`]); at a leaf, each triangle is tested against the whole packet when the
+//! processor has AVX-512 and the rays share the watertight test's axes (see
+//! [`super::packet_triangles`]), each ray tests the blocks alone otherwise. Either way every ray
 //! gets exactly the answer of its own query. Batches choose, sixteen rays at a time, between a
 //! packet (coherent rays: near origins, near directions) and single rays.
 
@@ -37,8 +39,8 @@ struct TrianglePacket<'a> {
 }
 
 impl<'a> TrianglePacket<'a> {
-    /// The leaf states of `rays` (at least one; lanes beyond them repeat the first and are never
-    /// asked for), of which `active` will be traced.
+    /// The state of a packet of `rays` (at least one; the lanes beyond them are never asked for),
+    /// of which `active` will be traced: no hit yet.
     fn new(bvh: &'a TriangleBvh, rays: &'a [Ray], active: u32) -> Self {
         let limits = Lanes(std::array::from_fn(|i| reach(rays.get(i).unwrap_or(&rays[0]).t_max)));
         // Only AVX-512 has the whole-packet triangle test.
