@@ -1,5 +1,5 @@
-//! Batches allocate nothing per ray: a counting global allocator watches a batch below the
-//! parallel threshold (nothing at all) and a large one (the thread pool's bookkeeping only, far
+//! Batches allocate nothing per ray: a counting global allocator watches batches below the
+//! parallel threshold, coherent (traced in packets) and not (nothing at all), and a large one (the thread pool's bookkeeping only, far
 //! fewer allocations than rays). One test in this binary, so that no other test's allocations
 //! are counted.
 
@@ -36,6 +36,14 @@ fn batches_allocate_nothing_per_ray() {
             Ray::new(Vec3::new((f * 0.37) % 40.0, (f * 0.61) % 40.0, 12.0), Vec3::new(0.1, -0.05, -1.0))
         })
         .collect();
+    // Coherent rays (a fan from one point), which batches trace in packets.
+    let fan: Vec<Ray> = (0..PARALLEL_BATCH as u32 - 1)
+        .map(|k| Ray::new(Vec3::new(20.0, 20.0, 30.0), Vec3::new((k % 32) as f32 * 0.01, (k / 32) as f32 * 0.01, -1.0)))
+        .collect();
+    let (mut hits, mut mask) = (vec![None; fan.len()], vec![false; fan.len()]);
+    assert_eq!(allocations_during(|| world.closest_hits(&fan, &mut hits).unwrap()), 0);
+    assert_eq!(allocations_during(|| world.any_hits(&fan, &mut mask).unwrap()), 0);
+    assert!(hits.iter().filter(|h| h.is_some()).count() > fan.len() / 4);
     let small = &rays[..PARALLEL_BATCH - 1];
     let (mut hits, mut mask) = (vec![None; small.len()], vec![false; small.len()]);
     assert_eq!(allocations_during(|| world.closest_hits(small, &mut hits).unwrap()), 0);
