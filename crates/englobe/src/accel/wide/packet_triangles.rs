@@ -57,7 +57,9 @@ impl PacketTriRays {
                 continue;
             }
             let d = ray.dir();
-            if WatertightRay::axes_of(d) != axes {
+            // Compared as one small integer: comparing the arrays made the compiler store them
+            // and load them back as a vector, a stall per ray.
+            if packed(WatertightRay::axes_of(d)) != packed(axes) {
                 return None;
             }
             let (o, inv) = (ray.origin(), ray.inv_dir());
@@ -82,6 +84,12 @@ impl PacketTriRays {
     pub fn axes(&self) -> [usize; 3] {
         self.axes
     }
+}
+
+/// Axes `[kx, ky, kz]` (each below 3) as one integer.
+#[inline(always)]
+fn packed(axes: [usize; 3]) -> usize {
+    axes[0] | axes[1] << 2 | axes[2] << 4
 }
 
 /// The closest hit of each ray of a packet so far, as a structure of arrays. A ray without a hit
