@@ -214,22 +214,25 @@ impl<'a> Renderer<'a> {
         let total = (tiles_x * tiles_y) as usize;
         let done = AtomicUsize::new(0);
         let cancelled = || self.cancel.is_some_and(|c| c.load(Ordering::Relaxed));
+        let tile_done = || {
+            let n = done.fetch_add(1, Ordering::Relaxed) + 1;
+            if let Some(progress) = self.progress {
+                progress(n, total);
+            }
+        };
 
         let tiles: Vec<Option<TileOutput>> = (0..total)
             .into_par_iter()
             .map(|index| {
                 let (x0, y0, x1, y1) = tile_at(index);
                 let mut tally = Tally::<C>::default();
-                let area = ((x1 - x0) * (y1 - y0)) as usize;
                 if self.primary_packets() {
                     let pixels =
                         self.tile_in_packets(&camera, &integrator, (x0, y0, x1, y1), &mut tally, &cancelled)?;
-                    let n = done.fetch_add(1, Ordering::Relaxed) + 1;
-                    if let Some(progress) = self.progress {
-                        progress(n, total);
-                    }
+                    tile_done();
                     return Some(TileOutput { pixels, stats: tally.stats(), cost: Vec::new() });
                 }
+                let area = ((x1 - x0) * (y1 - y0)) as usize;
                 let mut pixels = Vec::with_capacity(area);
                 let mut cost = Vec::with_capacity(if self.record_cost { area } else { 0 });
                 for y in y0..y1 {
@@ -254,10 +257,7 @@ impl<'a> Renderer<'a> {
                         }
                     }
                 }
-                let n = done.fetch_add(1, Ordering::Relaxed) + 1;
-                if let Some(progress) = self.progress {
-                    progress(n, total);
-                }
+                tile_done();
                 Some(TileOutput { pixels, stats: tally.stats(), cost })
             })
             .collect();

@@ -9,7 +9,7 @@
 
 use super::{World, WorldHit};
 use crate::Ray;
-use crate::accel::interface::batch::{run_batch_chunks, run_packets};
+use crate::accel::interface::batch::{run_batch_packets, run_packets};
 use crate::accel::wide::packet_kernels::PACKET;
 use crate::accel::wide::triangle_packet::coherent;
 use crate::accel::{BatchSizeMismatch, Counters, NoCount, NoFilter};
@@ -30,30 +30,28 @@ impl World {
     /// # Ok::<(), Box<dyn std::error::Error>>(())
     /// ```
     pub fn closest_hits(&self, rays: &[Ray], hits: &mut [Option<WorldHit>]) -> Result<(), BatchSizeMismatch> {
-        run_batch_chunks(rays, hits, PACKET, |rays, hits| {
-            if self.coherent(rays) {
-                self.closest_packet_of(rays, hits, &mut NoCount);
-            } else {
-                for (h, r) in hits.iter_mut().zip(rays) {
-                    *h = self.closest_hit(r, &mut NoCount);
-                }
-            }
-        })
+        run_batch_packets(
+            rays,
+            hits,
+            PACKET,
+            |rays| self.coherent(rays),
+            |rays, hits| self.closest_packet_of(rays, hits, &mut NoCount),
+            |r| self.closest_hit(r, &mut NoCount),
+        )
     }
 
     /// Whether each ray hits anything within its interval, `mask[i]` for `rays[i]`
     /// ([`World::any_hit`]); sixteen rays at a time, in a packet when they are coherent. The two
     /// slices must be as long.
     pub fn any_hits(&self, rays: &[Ray], mask: &mut [bool]) -> Result<(), BatchSizeMismatch> {
-        run_batch_chunks(rays, mask, PACKET, |rays, mask| {
-            if self.coherent(rays) {
-                self.any_packet_of(rays, mask, &mut NoCount);
-            } else {
-                for (m, r) in mask.iter_mut().zip(rays) {
-                    *m = self.any_hit(r, &mut NoCount);
-                }
-            }
-        })
+        run_batch_packets(
+            rays,
+            mask,
+            PACKET,
+            |rays| self.coherent(rays),
+            |rays, mask| self.any_packet_of(rays, mask, &mut NoCount),
+            |r| self.any_hit(r, &mut NoCount),
+        )
     }
 
     /// [`World::closest_hit`] of every ray, the meshes' triangles tested in packets of sixteen

@@ -276,8 +276,7 @@ impl<F: HitFilter<WorldHit>> HitFilter<Hit> for Located<'_, F> {
 
     #[inline(always)]
     fn accept(&mut self, h: &Hit) -> bool {
-        let (object, prim) = self.world.locate(h.prim);
-        self.filter.accept(&WorldHit { t: h.t, object, prim, u: h.u, v: h.v })
+        self.filter.accept(&self.world.mesh_hit(*h))
     }
 }
 

@@ -94,3 +94,24 @@ pub fn run_packets<T>(
     }
     Ok(())
 }
+
+/// [`run_batch_chunks`] by packets of `width` rays: each piece `coherent` accepts goes to
+/// `packet` whole, the others ray by ray to `single`.
+pub fn run_batch_packets<T: Send>(
+    rays: &[Ray],
+    out: &mut [T],
+    width: usize,
+    coherent: impl Fn(&[Ray]) -> bool + Sync,
+    packet: impl Fn(&[Ray], &mut [T]) + Sync,
+    single: impl Fn(&Ray) -> T + Sync,
+) -> Result<(), BatchSizeMismatch> {
+    run_batch_chunks(rays, out, width, |rays, out| {
+        if coherent(rays) {
+            packet(rays, out);
+        } else {
+            for (o, r) in out.iter_mut().zip(rays) {
+                *o = single(r);
+            }
+        }
+    })
+}

@@ -10,24 +10,20 @@
 //! in the same order, no fused multiply-add, the same *special* cases left to the scalar test.
 //! So every ray keeps the answer of its own query.
 
-use super::packet_kernels::{Lanes, PACKET};
+use super::packet_kernels::{Lanes, PACKET, PacketRays};
 use crate::Ray;
 use crate::shapes::WatertightRay;
 
-/// A packet whose rays share the watertight test's axes, prepared for triangle tests: the
-/// constants of [`super::triangles::TriRay`] as a structure of arrays.
+/// A packet whose rays share the watertight test's axes, prepared for triangle tests: what the
+/// constants of [`super::triangles::TriRay`] add to the packet's [`PacketRays`] (which holds the
+/// origins, inverse directions and `t_min`), as a structure of arrays.
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(64))]
 pub struct PacketTriRays {
     /// The origins' coordinates on the axes `kx`, `ky`, `kz`.
     origin_k: [Lanes; 3],
-    /// The origins by axis `x`, `y`, `z`.
-    origin: [Lanes; 3],
-    /// The inverse directions by axis.
-    inv_dir: [Lanes; 3],
     /// The shears `(d[kx] / d[kz], d[ky] / d[kz], 1 / d[kz])`.
     shear: [Lanes; 3],
-    t_min: Lanes,
     axes: [usize; 3],
 }
 
@@ -41,14 +37,7 @@ impl PacketTriRays {
         }
         let axes = WatertightRay::axes_of(rays[active.trailing_zeros() as usize].dir());
         let zero = Lanes([0.0; PACKET]);
-        let mut p = PacketTriRays {
-            origin_k: [zero; 3],
-            origin: [zero; 3],
-            inv_dir: [zero; 3],
-            shear: [zero; 3],
-            t_min: zero,
-            axes,
-        };
+        let mut p = PacketTriRays { origin_k: [zero; 3], shear: [zero; 3], axes };
         // The directions on the shared axes; 1 along `kz` in the lanes left out, so that the
         // divisions below stay finite there.
         let (mut dx, mut dy, mut dz) = ([0.0f32; PACKET], [0.0f32; PACKET], [1.0f32; PACKET]);
@@ -62,14 +51,11 @@ impl PacketTriRays {
             if packed(WatertightRay::axes_of(d)) != packed(axes) {
                 return None;
             }
-            let (o, inv) = (ray.origin(), ray.inv_dir());
+            let o = ray.origin();
             for a in 0..3 {
                 p.origin_k[a].0[i] = o[axes[a]];
-                p.origin[a].0[i] = o[a];
-                p.inv_dir[a].0[i] = inv[a];
             }
             (dx[i], dy[i], dz[i]) = (d[axes[0]], d[axes[1]], d[axes[2]]);
-            p.t_min.0[i] = ray.t_min;
         }
         // The shear of `WatertightRay::new`, the same divisions lane by lane (one vector loop).
         for i in 0..PACKET {
@@ -78,11 +64,6 @@ impl PacketTriRays {
             p.shear[2].0[i] = 1.0 / dz[i];
         }
         Some(p)
-    }
-
-    /// The axes `[kx, ky, kz]` the rays share.
-    pub fn axes(&self) -> [usize; 3] {
-        self.axes
     }
 }
 
@@ -130,12 +111,13 @@ mod x86 {
     use std::arch::x86_64::*;
 
     use super::super::triangles::{LANES, TriBlock, UNUSED};
-    use super::{PacketBest, PacketTriRays};
+    use super::{PacketBest, PacketRays, PacketTriRays};
     use crate::geom::aabb::ROBUST_FAR_SCALE;
 
-    /// Tests the rays of `rays` against every used triangle of `block`. With `closest`, keeps
-    /// each ray's closest hit in `best` (closer, or as close with a lower index, as
-    /// [`crate::accel::HitRecord::offer`]); without, only reports hits within `best.t`. Returns
+    /// Tests the rays of `rays` (bits of the packet `packet`, whose shared-axes constants are
+    /// `r`) against every used triangle of `block`. With `closest`, keeps each ray's closest hit
+    /// in `best` (closer, or as close with a lower index, as [`crate::accel::HitRecord::offer`]);
+    /// without, only reports hits within `best.t`. Returns
     /// the rays that hit, and the pairs the scalar test must decide (bit `16 * lane + ray`).
     ///
     /// # Safety
@@ -143,6 +125,7 @@ mod x86 {
     #[target_feature(enable = "avx2,fma,avx512f,avx512vl,avx512bw,avx512dq")]
     pub unsafe fn block_avx512(
         block: &TriBlock,
+        packet: &PacketRays,
         r: &PacketTriRays,
         rays: u32,
         best: &mut PacketBest,
@@ -206,8 +189,8 @@ mod x86 {
                 for axis in 0..3 {
                     let (p, q, s) = (at(0, axis), at(1, axis), at(2, axis));
                     let (lo, hi) = (_mm512_set1_ps(p.min(q).min(s)), _mm512_set1_ps(p.max(q).max(s)));
-                    let inv = load(&r.inv_dir[axis]);
-                    let o = load(&r.origin[axis]);
+                    let inv = load(&packet.inv_dir[axis]);
+                    let o = load(&packet.origin[axis]);
                     let positive_dir = _mm512_cmp_ps_mask::<_CMP_GE_OQ>(inv, zero);
                     let near = _mm512_mask_blend_ps(positive_dir, hi, lo);
                     let far = _mm512_mask_blend_ps(positive_dir, lo, hi);
@@ -222,8 +205,8 @@ mod x86 {
                 let t = _mm512_mask_blend_ps(_mm512_cmp_ps_mask::<_CMP_LT_OQ>(t, enter), t, enter);
                 let t = _mm512_mask_blend_ps(_mm512_cmp_ps_mask::<_CMP_GT_OQ>(t, exit), t, exit);
                 let best_t = load(&best.t);
-                let in_range =
-                    _mm512_cmp_ps_mask::<_CMP_GE_OQ>(t, load(&r.t_min)) & _mm512_cmp_ps_mask::<_CMP_LE_OQ>(t, best_t);
+                let in_range = _mm512_cmp_ps_mask::<_CMP_GE_OQ>(t, load(&packet.t_min))
+                    & _mm512_cmp_ps_mask::<_CMP_LE_OQ>(t, best_t);
                 let hit = candidate & in_box & in_range;
                 hit_rays |= hit;
                 if closest && hit != 0 {

@@ -14,9 +14,9 @@ use super::packet_kernels::{Lanes, PACKET, PacketRays};
 use super::packet_triangles;
 use super::packet_triangles::{PacketBest, PacketTriRays};
 use super::traverse::Leaves;
-use super::triangle_bvh::{TriangleBvh, TriangleLeaves};
-use super::triangles::{TriBlock, TriRay};
-use crate::accel::interface::batch::{run_batch_chunks, run_packets};
+use super::triangle_bvh::{TriangleBvh, TriangleLeaves, prefetch_block};
+use super::triangles::TriRay;
+use crate::accel::interface::batch::{run_batch_packets, run_packets};
 use crate::accel::{BatchSizeMismatch, Counters, Hit, NoCount, NoFilter};
 use crate::{Aabb, Ray};
 
@@ -25,8 +25,10 @@ use crate::{Aabb, Ray};
 /// once; otherwise each ray's leaves are tested by the single-ray leaf test.
 struct TrianglePacket<'a> {
     rays: &'a [Ray],
+    /// The same rays prepared for node tests (their origins, inverse directions and `t_min` are
+    /// read by the whole-packet triangle test too).
+    packet: &'a PacketRays,
     bvh: &'a TriangleBvh,
-    blocks: &'a [TriBlock],
     /// The shared-axes constants, when the packet's triangle tests run on whole packets;
     /// prepared at the first leaf (rays that reach none never pay for them).
     simd: Option<PacketTriRays>,
@@ -41,20 +43,11 @@ struct TrianglePacket<'a> {
 impl<'a> TrianglePacket<'a> {
     /// The state of a packet of `rays` (at least one; the lanes beyond them are never asked for),
     /// of which `active` will be traced: no hit yet.
-    fn new(bvh: &'a TriangleBvh, rays: &'a [Ray], active: u32) -> Self {
+    fn new(bvh: &'a TriangleBvh, rays: &'a [Ray], packet: &'a PacketRays, active: u32) -> Self {
         let limits = Lanes(std::array::from_fn(|i| reach(rays.get(i).unwrap_or(&rays[0]).t_max)));
         // Only AVX-512 has the whole-packet triangle test.
         let decided = !(cfg!(target_arch = "x86_64") && bvh.isa() == Isa::Avx512);
-        TrianglePacket {
-            rays,
-            bvh,
-            blocks: bvh.blocks(),
-            simd: None,
-            decided,
-            active,
-            best: PacketBest::new(rays),
-            limits,
-        }
+        TrianglePacket { rays, packet, bvh, simd: None, decided, active, best: PacketBest::new(rays), limits }
     }
 
     /// The whole-packet triangle constants, if the packet's rays share their axes (see `simd`).
@@ -71,7 +64,8 @@ impl<'a> TrianglePacket<'a> {
     #[inline(always)]
     fn lane(&self, i: usize) -> TriangleLeaves<'a, NoFilter> {
         let source = &self.rays[i.min(self.rays.len() - 1)];
-        TriangleLeaves { blocks: self.blocks, source, ray: None, best: None, t_max: self.best.t.0[i], filter: NoFilter }
+        let blocks = self.bvh.blocks();
+        TriangleLeaves { blocks, source, ray: None, best: None, t_max: self.best.t.0[i], filter: NoFilter }
     }
 
     /// The closest hit of ray `i`.
@@ -90,7 +84,7 @@ impl<'a> TrianglePacket<'a> {
     }
 
     /// Tests the blocks from `first` against the rays of `rays` a whole packet at a time; returns
-    /// the rays that hit (with `closest`, their closest hits are kept).
+    /// the rays that hit one (with `closest`, their closest hits are kept).
     #[cfg(target_arch = "x86_64")]
     #[inline(always)]
     fn simd_blocks<C: Counters>(
@@ -103,14 +97,16 @@ impl<'a> TrianglePacket<'a> {
         counters: &mut C,
     ) -> u32 {
         let mut found = 0;
-        for block in &self.blocks[first as usize..(first + count) as usize] {
+        for block in &self.bvh.blocks()[first as usize..(first + count) as usize] {
             for _ in 0..block.used() * rays.count_ones() {
                 counters.exact_test();
             }
+            // Any hit: the rays that found an occluder are done.
+            let pending = if closest { rays } else { rays & !found };
             // SAFETY: `simd` is only prepared for structures whose instruction set is AVX-512,
             // which the processor has (see `Isa`).
             let (hit, mut special) =
-                unsafe { packet_triangles::block_avx512(block, tri, rays & !found, &mut self.best, closest) };
+                unsafe { packet_triangles::block_avx512(block, self.packet, tri, pending, &mut self.best, closest) };
             found |= hit;
             while special != 0 {
                 let bit = special.trailing_zeros() as usize;
@@ -126,9 +122,6 @@ impl<'a> TrianglePacket<'a> {
             }
             if !closest && found == rays {
                 break;
-            }
-            if closest {
-                found = 0;
             }
         }
         found
@@ -186,7 +179,7 @@ impl<C: Counters> PacketLeaves<C> for TrianglePacket<'_> {
 
     #[inline(always)]
     fn prefetch(&self, first: u32) {
-        Leaves::<C>::prefetch(&self.lane(0), first);
+        prefetch_block(self.bvh.blocks(), first);
     }
 
     #[inline(never)]
@@ -273,28 +266,26 @@ impl TriangleBvh {
     /// large batches (see [`crate::accel::interface::batch`]); sixteen rays at a time, in a packet
     /// when they are coherent, one by one otherwise. The two slices must be as long.
     pub fn closest_hits(&self, rays: &[Ray], hits: &mut [Option<Hit>]) -> Result<(), BatchSizeMismatch> {
-        run_batch_chunks(rays, hits, PACKET, |rays, hits| {
-            if coherent(rays, &self.bounds()) {
-                self.closest_packet_of(rays, hits, &mut NoCount);
-            } else {
-                for (h, r) in hits.iter_mut().zip(rays) {
-                    *h = self.closest_hit(r, &mut NoCount);
-                }
-            }
-        })
+        run_batch_packets(
+            rays,
+            hits,
+            PACKET,
+            |rays| coherent(rays, &self.bounds()),
+            |rays, hits| self.closest_packet_of(rays, hits, &mut NoCount),
+            |r| self.closest_hit(r, &mut NoCount),
+        )
     }
 
     /// Whether each ray hits anything, `mask[i]` for `rays[i]` (see [`TriangleBvh::closest_hits`]).
     pub fn any_hits(&self, rays: &[Ray], mask: &mut [bool]) -> Result<(), BatchSizeMismatch> {
-        run_batch_chunks(rays, mask, PACKET, |rays, mask| {
-            if coherent(rays, &self.bounds()) {
-                self.any_packet_of(rays, mask, &mut NoCount);
-            } else {
-                for (m, r) in mask.iter_mut().zip(rays) {
-                    *m = self.any_hit(r, &mut NoCount);
-                }
-            }
-        })
+        run_batch_packets(
+            rays,
+            mask,
+            PACKET,
+            |rays| coherent(rays, &self.bounds()),
+            |rays, mask| self.any_packet_of(rays, mask, &mut NoCount),
+            |r| self.any_hit(r, &mut NoCount),
+        )
     }
 
     /// One packet of 1 to [`PACKET`] rays.
@@ -310,8 +301,9 @@ impl TriangleBvh {
             return;
         }
         let active = valid_mask(rays);
-        let mut leaves = TrianglePacket::new(self, rays, active);
-        dispatch::closest_packet(self.isa(), self.nodes(), &PacketRays::new(rays), active, &mut leaves, counters);
+        let packet = PacketRays::new(rays);
+        let mut leaves = TrianglePacket::new(self, rays, &packet, active);
+        dispatch::closest_packet(self.isa(), self.nodes(), &packet, active, &mut leaves, counters);
         for (i, h) in hits.iter_mut().enumerate() {
             *h = leaves.hit(i);
         }
@@ -330,8 +322,9 @@ impl TriangleBvh {
             return;
         }
         let active = valid_mask(rays);
-        let mut leaves = TrianglePacket::new(self, rays, active);
-        let hit = dispatch::any_packet(self.isa(), self.nodes(), &PacketRays::new(rays), active, &mut leaves, counters);
+        let packet = PacketRays::new(rays);
+        let mut leaves = TrianglePacket::new(self, rays, &packet, active);
+        let hit = dispatch::any_packet(self.isa(), self.nodes(), &packet, active, &mut leaves, counters);
         for (i, m) in mask.iter_mut().enumerate() {
             *m = hit >> i & 1 != 0;
         }
