@@ -1,7 +1,8 @@
 //! Primary rays in packets: a tile's pixels taken four by four, the sixteen camera rays of each
 //! sample traced together ([`englobe::World::closest_hit_packet`]: one node test for the whole
 //! packet, see `englobe::accel::wide::packet`), then each pixel's sample finished by the
-//! integrator from its hit, as if it had found the hit itself.
+//! integrator from its hit, as if it had found the hit itself. Whitted's integrator also traces
+//! the packet's shadow rays toward each light together ([`crate::whitted::Whitted::radiance_packet`]).
 //!
 //! Every pixel keeps its own random numbers, drawn in the same order, and every ray its own
 //! closest hit, so the image is bit for bit the one a pixel-by-pixel render makes. What changes is
@@ -74,8 +75,10 @@ impl Renderer<'_> {
                     }
                     let vis = integrator.visibility();
                     vis.closest_hit_packet(&rays[..n], &mut hits[..n], &mut tally.work[RayKind::Primary as usize]);
+                    let mut radiances = [Vec3::ZERO; PACKET];
+                    integrator.radiances_from(&rays[..n], &hits[..n], &mut rngs[..n], tally, &mut radiances[..n]);
                     for i in 0..n {
-                        let radiance = self.clamped(integrator.radiance_from(&rays[i], hits[i], &mut rngs[i], tally));
+                        let radiance = self.clamped(radiances[i]);
                         // One sample is the pixel itself (not `0 + sample`, which would turn -0 into +0).
                         sums[i] = if self.samples == 1 { radiance } else { sums[i] + radiance };
                     }
@@ -99,17 +102,24 @@ impl Integrator<'_> {
         }
     }
 
-    /// The radiance of a primary `ray` whose closest hit is `hit`.
-    fn radiance_from<C: Counters>(
+    /// The radiance of each primary ray, `out[i]` for `rays[i]` whose closest hit is `hits[i]`:
+    /// Whitted's shadow rays toward each light in packets too, the path tracer's samples one by
+    /// one (each draws its own random numbers).
+    fn radiances_from<C: Counters>(
         &self,
-        ray: &Ray,
-        hit: Option<WorldHit>,
-        rng: &mut PixelSampler,
+        rays: &[Ray],
+        hits: &[Option<WorldHit>],
+        rngs: &mut [PixelSampler],
         tally: &mut Tally<C>,
-    ) -> Vec3 {
+        out: &mut [Vec3],
+    ) {
         match self {
-            Integrator::Whitted(w) => w.radiance_from(ray, hit, tally),
-            Integrator::Path(p) => p.radiance_from(ray, Some(hit), rng, tally),
+            Integrator::Whitted(w) => w.radiance_packet(rays, hits, tally, out),
+            Integrator::Path(p) => {
+                for (i, o) in out.iter_mut().enumerate() {
+                    *o = p.radiance_from(&rays[i], Some(hits[i]), &mut rngs[i], tally);
+                }
+            }
         }
     }
 }

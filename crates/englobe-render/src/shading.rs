@@ -104,9 +104,33 @@ impl<'a> Surface<'a> {
         offset_ray_origin(self.p, -self.n)
     }
 
+    /// The light `light` sends to the point, if it is in front of the surface: `(to_light,
+    /// radiance, shadow_ray)`, `to_light` the unit direction to the light, `radiance` what arrives
+    /// (in the units of the module's note) unless `shadow_ray`, which starts at `origin` (the
+    /// point moved off the surface: [`Surface::outside`]), meets something.
+    #[inline]
+    pub fn light_ray(&self, light: &Light, origin: Vec3) -> Option<(Vec3, Vec3, Ray)> {
+        let (to_light, radiance) = match *light {
+            Light::Point { position, power } => {
+                // Shading uses the true point; only the shadow ray starts off the surface.
+                let v = position - self.p;
+                let dist2 = v.length_squared();
+                (v / dist2.sqrt(), power / dist2)
+            }
+            Light::Directional { direction, radiance } => (-direction, radiance),
+        };
+        if to_light.dot(self.n) <= 0.0 || !to_light.is_finite() {
+            return None; // the light is behind the surface
+        }
+        let shadow_ray = match *light {
+            Light::Point { position, .. } => Ray::segment(origin, position - origin, 0.0, SHADOW_RAY_END),
+            Light::Directional { direction, .. } => Ray::new(origin, -direction),
+        };
+        Some((to_light, radiance, shadow_ray))
+    }
+
     /// Calls `f(to_light, radiance)` for every point or directional light in front of the
-    /// surface that the point sees, one shadow ray per light: `to_light` the unit direction to
-    /// the light, `radiance` what arrives in the units of the module's note.
+    /// surface that the point sees, one shadow ray per light (see [`Surface::light_ray`]).
     pub fn for_each_light<C: Counters>(
         &self,
         scene: &Scene,
@@ -116,22 +140,7 @@ impl<'a> Surface<'a> {
     ) {
         let origin = self.outside();
         for light in &scene.lights {
-            let (to_light, radiance) = match *light {
-                Light::Point { position, power } => {
-                    // Shading uses the true point; only the shadow ray starts off the surface.
-                    let v = position - self.p;
-                    let dist2 = v.length_squared();
-                    (v / dist2.sqrt(), power / dist2)
-                }
-                Light::Directional { direction, radiance } => (-direction, radiance),
-            };
-            if to_light.dot(self.n) <= 0.0 || !to_light.is_finite() {
-                continue; // the light is behind the surface
-            }
-            let shadow_ray = match *light {
-                Light::Point { position, .. } => Ray::segment(origin, position - origin, 0.0, SHADOW_RAY_END),
-                Light::Directional { direction, .. } => Ray::new(origin, -direction),
-            };
+            let Some((to_light, radiance, shadow_ray)) = self.light_ray(light, origin) else { continue };
             tally.rays[RayKind::Shadow as usize] += 1;
             if vis.any_hit(&shadow_ray, &mut tally.work[RayKind::Shadow as usize]) {
                 continue;
@@ -140,20 +149,37 @@ impl<'a> Surface<'a> {
         }
     }
 
+    /// Whether this surface has a Blinn-Phong highlight: a classic material with a specular
+    /// colour (a metallic-roughness material reaches Whitted's integrator as its diffuse base
+    /// colour).
+    pub(crate) fn shiny(&self) -> bool {
+        self.params.specular != Vec3::ZERO && self.material.model == MaterialModel::Classic
+    }
+
+    /// What one light that the point sees adds to [`Surface::direct_light`]'s `(diffuse,
+    /// highlight)`, given [`Surface::shiny`].
+    #[inline]
+    pub fn light_response(&self, shiny: bool, to_light: Vec3, radiance: Vec3) -> (Vec3, Vec3) {
+        let m = &self.params;
+        let diffuse = m.base_color * self.ns.dot(to_light).max(0.0) * radiance;
+        if !shiny {
+            return (diffuse, Vec3::ZERO);
+        }
+        let half = (to_light - self.d).normalize_or_zero();
+        (diffuse, m.specular * self.ns.dot(half).max(0.0).powf(self.material.shininess) * radiance)
+    }
+
     /// The diffuse and highlight light arriving from every light that the point sees, one
     /// shadow ray per light in front of the surface. Returns `(diffuse, highlight)`, the first
     /// to be weighted by the surface's diffuse share.
     pub fn direct_light<C: Counters>(&self, scene: &Scene, vis: &Visibility, tally: &mut Tally<C>) -> (Vec3, Vec3) {
-        let m = &self.params;
-        // The Blinn-Phong highlight belongs to the classic model; a metallic-roughness material
-        // reaches Whitted's integrator as its diffuse base colour.
-        let shiny = m.specular != Vec3::ZERO && self.material.model == MaterialModel::Classic;
+        let shiny = self.shiny();
         let (mut diffuse, mut highlight) = (Vec3::ZERO, Vec3::ZERO);
         self.for_each_light(scene, vis, tally, |to_light, radiance| {
-            diffuse += m.base_color * self.ns.dot(to_light).max(0.0) * radiance;
+            let (d, h) = self.light_response(shiny, to_light, radiance);
+            diffuse += d;
             if shiny {
-                let half = (to_light - self.d).normalize_or_zero();
-                highlight += m.specular * self.ns.dot(half).max(0.0).powf(self.material.shininess) * radiance;
+                highlight += h;
             }
         });
         (diffuse, highlight)

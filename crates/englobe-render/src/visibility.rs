@@ -101,6 +101,20 @@ impl<'a> Visibility<'a> {
         }
     }
 
+    /// [`Visibility::any_hit`] of each ray, `blocked[i]` for `rays[i]`, the rays traced in
+    /// packets of sixteen (see [`World::any_hit_packet`]) unless cut-outs need a filter. The two
+    /// slices are as long.
+    pub fn any_hit_packet<C: Counters>(&self, rays: &[Ray], blocked: &mut [bool], counters: &mut C) {
+        debug_assert_eq!(rays.len(), blocked.len());
+        if self.filtered {
+            for (b, r) in blocked.iter_mut().zip(rays) {
+                *b = self.any_hit(r, counters);
+            }
+        } else {
+            self.world.any_hit_packet(rays, blocked, counters).expect("as many places as rays");
+        }
+    }
+
     /// Whether a surface that is there lies within the ray's interval.
     #[inline]
     pub fn any_hit<C: Counters>(&self, ray: &Ray, counters: &mut C) -> bool {

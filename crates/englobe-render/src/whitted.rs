@@ -33,6 +33,9 @@ use crate::shading::Surface;
 use crate::stats::{RayKind, Tally};
 use crate::visibility::Visibility;
 
+/// Most primary rays [`Whitted::radiance_packet`] takes at once.
+pub const PACKET: usize = 16;
+
 /// The Whitted integrator over a scene and its world (built from the scene's objects, in order).
 pub struct Whitted<'a> {
     scene: &'a Scene,
@@ -95,6 +98,65 @@ impl<'a> Whitted<'a> {
         self.shade(ray, hit, depth, weight, cone, tally)
     }
 
+    /// [`Whitted::radiance_from`] of each primary ray, `out[i]` for `rays[i]` and its closest hit
+    /// `hits[i]`, the shadow rays toward each light traced together, in packets (see
+    /// [`Visibility::any_hit_packet`]). Each surface sums its lights in the scene's order, as
+    /// [`Surface::direct_light`] does, so every colour is the same bits as `radiance_from`'s.
+    pub fn radiance_packet<C: Counters>(
+        &self,
+        rays: &[Ray],
+        hits: &[Option<WorldHit>],
+        tally: &mut Tally<C>,
+        out: &mut [Vec3],
+    ) {
+        let n = rays.len();
+        assert!(n <= PACKET && hits.len() == n && out.len() == n, "a packet holds at most {PACKET} rays");
+        tally.rays[RayKind::Primary as usize] += n as u64;
+        // Filled in place: a surface is large, and copies of it cost more than its shading.
+        let mut surfaces: [Option<Surface>; PACKET] = std::array::from_fn(|_| None);
+        for ((slot, ray), hit) in surfaces.iter_mut().zip(rays).zip(hits) {
+            if let Some(hit) = hit {
+                *slot = Some(Surface::at_over(self.scene, self.world, ray, hit, self.cone));
+            }
+        }
+        let origins: [Vec3; PACKET] = std::array::from_fn(|i| surfaces[i].as_ref().map_or(Vec3::ZERO, |s| s.outside()));
+        let shiny: [bool; PACKET] = std::array::from_fn(|i| surfaces[i].as_ref().is_some_and(|s| s.shiny()));
+        let mut light = [(Vec3::ZERO, Vec3::ZERO); PACKET];
+        for source in &self.scene.lights {
+            // The shadow rays of the surfaces in front of which this light is, side by side.
+            let mut shadow = [Ray::new(Vec3::ZERO, Vec3::Z); PACKET];
+            let mut arriving = [(0usize, Vec3::ZERO, Vec3::ZERO); PACKET];
+            let mut count = 0;
+            for (i, s) in surfaces.iter().enumerate() {
+                if let Some((to_light, radiance, ray)) = s.as_ref().and_then(|s| s.light_ray(source, origins[i])) {
+                    shadow[count] = ray;
+                    arriving[count] = (i, to_light, radiance);
+                    count += 1;
+                }
+            }
+            if count == 0 {
+                continue;
+            }
+            tally.rays[RayKind::Shadow as usize] += count as u64;
+            let mut blocked = [false; PACKET];
+            self.vis.any_hit_packet(&shadow[..count], &mut blocked[..count], &mut tally.work[RayKind::Shadow as usize]);
+            for (&(i, to_light, radiance), _) in arriving[..count].iter().zip(blocked).filter(|(_, b)| !b) {
+                let s = surfaces[i].as_ref().expect("a shadow ray leaves a surface");
+                let (d, h) = s.light_response(shiny[i], to_light, radiance);
+                light[i].0 += d;
+                if shiny[i] {
+                    light[i].1 += h;
+                }
+            }
+        }
+        for (i, color) in out.iter_mut().enumerate() {
+            *color = match &surfaces[i] {
+                Some(s) => self.shade_lit(&rays[i], s, light[i], 0, 1.0, self.cone, tally),
+                None => self.shade(&rays[i], None, 0, 1.0, self.cone, tally),
+            };
+        }
+    }
+
     /// The colour seen along `ray` (see [`Whitted::trace`]), whose closest hit is `hit`.
     fn shade<C: Counters>(
         &self,
@@ -109,9 +171,25 @@ impl<'a> Whitted<'a> {
             return self.environment.as_ref().map_or(self.scene.image.background, |e| e.radiance(ray.dir()));
         };
         let s = Surface::at_over(self.scene, self.world, ray, &hit, cone);
+        let (lit, highlight) = s.direct_light(self.scene, &self.vis, tally);
+        self.shade_lit(ray, &s, (lit, highlight), depth, weight, cone, tally)
+    }
+
+    /// The colour seen along `ray` (see [`Whitted::trace`]), whose closest hit is the surface `s`
+    /// and the direct light `(lit, highlight)` it receives (see [`Surface::direct_light`]).
+    #[allow(clippy::too_many_arguments)]
+    fn shade_lit<C: Counters>(
+        &self,
+        ray: &Ray,
+        s: &Surface,
+        (lit, highlight): (Vec3, Vec3),
+        depth: u32,
+        weight: f32,
+        cone: Option<RayCone>,
+        tally: &mut Tally<C>,
+    ) -> Vec3 {
         let m = s.material;
         let (kr, kt) = (m.reflectivity, m.transparency);
-        let (lit, highlight) = s.direct_light(self.scene, &self.vis, tally);
         let diffuse = self.scene.image.ambient * s.params.base_color * s.params.occlusion + lit;
         let mut color = s.params.emission + diffuse * (1.0 - kr - kt) + highlight;
 
