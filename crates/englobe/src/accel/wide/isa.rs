@@ -51,8 +51,17 @@ impl Isa {
         Isa::ALL.into_iter().filter(|i| i.is_available()).collect()
     }
 
-    /// The widest available instruction set that measured fastest (see `docs/performance.md`).
+    /// The widest available instruction set that measured fastest (see `docs/performance.md`),
+    /// or the narrower one that the environment variable `ENGLOBE_ISA` names (`portable`,
+    /// `avx2`), for measuring a narrower processor's kernels on a wider one. A name this
+    /// processor cannot run, or not an instruction set's, leaves the widest. Read once.
     pub fn best() -> Isa {
+        static CHOSEN: OnceLock<Isa> = OnceLock::new();
+        *CHOSEN.get_or_init(|| Isa::chosen(Isa::widest(), std::env::var("ENGLOBE_ISA").ok().as_deref()))
+    }
+
+    /// The widest instruction set this processor can run.
+    fn widest() -> Isa {
         if Isa::Avx512.is_available() {
             Isa::Avx512
         } else if Isa::Avx2.is_available() {
@@ -60,6 +69,14 @@ impl Isa {
         } else {
             Isa::Portable
         }
+    }
+
+    /// `widest`, or the available instruction set no wider than it that `asked` names.
+    fn chosen(widest: Isa, asked: Option<&str>) -> Isa {
+        Isa::ALL
+            .into_iter()
+            .find(|i| Some(i.name()) == asked && *i <= widest && i.is_available())
+            .unwrap_or(widest)
     }
 }
 
@@ -109,5 +126,18 @@ mod tests {
         assert_eq!(Isa::available()[0], Isa::Portable);
         // AVX-512 implies AVX2: the dispatch relies on it.
         assert!(!Isa::Avx512.is_available() || Isa::Avx2.is_available());
+    }
+
+    #[test]
+    fn the_environment_narrows_the_choice_and_never_widens_it() {
+        let widest = Isa::widest();
+        assert_eq!(Isa::chosen(widest, None), widest);
+        assert_eq!(Isa::chosen(widest, Some("portable")), Isa::Portable);
+        assert_eq!(Isa::chosen(Isa::Portable, Some("avx512")), Isa::Portable);
+        assert_eq!(Isa::chosen(widest, Some("sse9")), widest);
+        assert_eq!(Isa::chosen(widest, Some("AVX2")), widest, "names are matched exactly");
+        if Isa::Avx2.is_available() {
+            assert_eq!(Isa::chosen(widest, Some("avx2")), Isa::Avx2);
+        }
     }
 }
