@@ -73,10 +73,7 @@ impl Isa {
 
     /// `widest`, or the available instruction set no wider than it that `asked` names.
     fn chosen(widest: Isa, asked: Option<&str>) -> Isa {
-        Isa::ALL
-            .into_iter()
-            .find(|i| Some(i.name()) == asked && *i <= widest && i.is_available())
-            .unwrap_or(widest)
+        Isa::ALL.into_iter().find(|i| Some(i.name()) == asked && *i <= widest && i.is_available()).unwrap_or(widest)
     }
 }
 

@@ -7,7 +7,7 @@
 
 use super::dispatch;
 use super::isa::Isa;
-use super::node::{NodeRay, reach};
+use super::node::{NodeRay, may_enter, reach};
 use super::packet::{self, PacketLeaves};
 use super::packet_kernels::{Lanes, PACKET, PacketRays};
 #[cfg(target_arch = "x86_64")]
@@ -210,9 +210,14 @@ impl<C: Counters> PacketLeaves<C> for TrianglePacket<'_> {
     }
 }
 
-/// The rays of `rays` that a query can take (see [`Ray::is_valid`]), bit per ray.
-fn valid_mask(rays: &[Ray]) -> u32 {
-    rays.iter().enumerate().fold(0, |m, (i, r)| m | (r.is_valid() as u32) << i)
+/// The rays of `rays` that may hit something in `bounds`, the tree's box: valid, and entering the
+/// box within their interval ([`may_enter`], which never refuses a ray that a child takes). The
+/// others cannot hit; a packet none of whose rays enters costs these few tests and nothing more
+/// (no packet state, no node), as a single ray that passes beside the box does.
+fn entering_mask(rays: &[Ray], bounds: &Aabb) -> u32 {
+    rays.iter()
+        .enumerate()
+        .fold(0, |m, (i, r)| m | ((r.is_valid() && may_enter(bounds, r, reach(r.t_max))) as u32) << i)
 }
 
 /// Whether `rays` are coherent enough to walk the tree together: directions within about 25
@@ -300,7 +305,11 @@ impl TriangleBvh {
             }
             return;
         }
-        let active = valid_mask(rays);
+        let active = entering_mask(rays, &self.bounds());
+        if active == 0 {
+            hits.fill(None);
+            return;
+        }
         let packet = PacketRays::new(rays);
         let mut leaves = TrianglePacket::new(self, rays, &packet, active);
         dispatch::closest_packet(self.isa(), self.nodes(), &packet, active, &mut leaves, counters);
@@ -321,7 +330,11 @@ impl TriangleBvh {
             }
             return;
         }
-        let active = valid_mask(rays);
+        let active = entering_mask(rays, &self.bounds());
+        if active == 0 {
+            mask.fill(false);
+            return;
+        }
         let packet = PacketRays::new(rays);
         let mut leaves = TrianglePacket::new(self, rays, &packet, active);
         let hit = dispatch::any_packet(self.isa(), self.nodes(), &packet, active, &mut leaves, counters);
