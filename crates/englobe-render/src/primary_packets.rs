@@ -19,8 +19,9 @@ use crate::stats::{RayKind, Tally};
 
 /// Side of a packet's square of pixels.
 const BLOCK: u32 = 4;
-/// Pixels (rays) per packet.
-const PACKET: usize = (BLOCK * BLOCK) as usize;
+/// Pixels (rays) per packet: as many as Whitted's integrator shades at once.
+const PACKET: usize = crate::whitted::PACKET;
+const _: () = assert!((BLOCK * BLOCK) as usize == PACKET, "a packet is a square of pixels");
 
 impl Renderer<'_> {
     /// Whether this render traces its primary rays in packets (see the module documentation):

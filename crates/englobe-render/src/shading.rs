@@ -149,20 +149,14 @@ impl<'a> Surface<'a> {
         }
     }
 
-    /// Whether this surface has a Blinn-Phong highlight: a classic material with a specular
-    /// colour (a metallic-roughness material reaches Whitted's integrator as its diffuse base
-    /// colour).
-    pub(crate) fn shiny(&self) -> bool {
-        self.params.specular != Vec3::ZERO && self.material.model == MaterialModel::Classic
-    }
-
     /// What one light that the point sees adds to [`Surface::direct_light`]'s `(diffuse,
-    /// highlight)`, given [`Surface::shiny`].
+    /// highlight)`. The Blinn-Phong highlight belongs to the classic model; a metallic-roughness
+    /// material reaches Whitted's integrator as its diffuse base colour (zero highlight).
     #[inline]
-    pub fn light_response(&self, shiny: bool, to_light: Vec3, radiance: Vec3) -> (Vec3, Vec3) {
+    pub fn light_response(&self, to_light: Vec3, radiance: Vec3) -> (Vec3, Vec3) {
         let m = &self.params;
         let diffuse = m.base_color * self.ns.dot(to_light).max(0.0) * radiance;
-        if !shiny {
+        if m.specular == Vec3::ZERO || self.material.model != MaterialModel::Classic {
             return (diffuse, Vec3::ZERO);
         }
         let half = (to_light - self.d).normalize_or_zero();
@@ -173,14 +167,11 @@ impl<'a> Surface<'a> {
     /// shadow ray per light in front of the surface. Returns `(diffuse, highlight)`, the first
     /// to be weighted by the surface's diffuse share.
     pub fn direct_light<C: Counters>(&self, scene: &Scene, vis: &Visibility, tally: &mut Tally<C>) -> (Vec3, Vec3) {
-        let shiny = self.shiny();
         let (mut diffuse, mut highlight) = (Vec3::ZERO, Vec3::ZERO);
         self.for_each_light(scene, vis, tally, |to_light, radiance| {
-            let (d, h) = self.light_response(shiny, to_light, radiance);
+            let (d, h) = self.light_response(to_light, radiance);
             diffuse += d;
-            if shiny {
-                highlight += h;
-            }
+            highlight += h;
         });
         (diffuse, highlight)
     }

@@ -120,7 +120,6 @@ impl<'a> Whitted<'a> {
             }
         }
         let origins: [Vec3; PACKET] = std::array::from_fn(|i| surfaces[i].as_ref().map_or(Vec3::ZERO, |s| s.outside()));
-        let shiny: [bool; PACKET] = std::array::from_fn(|i| surfaces[i].as_ref().is_some_and(|s| s.shiny()));
         let mut light = [(Vec3::ZERO, Vec3::ZERO); PACKET];
         for source in &self.scene.lights {
             // The shadow rays of the surfaces in front of which this light is, side by side.
@@ -142,11 +141,9 @@ impl<'a> Whitted<'a> {
             self.vis.any_hit_packet(&shadow[..count], &mut blocked[..count], &mut tally.work[RayKind::Shadow as usize]);
             for (&(i, to_light, radiance), _) in arriving[..count].iter().zip(blocked).filter(|(_, b)| !b) {
                 let s = surfaces[i].as_ref().expect("a shadow ray leaves a surface");
-                let (d, h) = s.light_response(shiny[i], to_light, radiance);
+                let (d, h) = s.light_response(to_light, radiance);
                 light[i].0 += d;
-                if shiny[i] {
-                    light[i].1 += h;
-                }
+                light[i].1 += h;
             }
         }
         for (i, color) in out.iter_mut().enumerate() {

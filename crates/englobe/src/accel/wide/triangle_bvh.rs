@@ -13,7 +13,7 @@ use super::dispatch;
 use super::isa::{Isa, IsaUnavailable};
 use super::node::{NodeRay, WideNode, may_enter, reach};
 use super::presplit::presplit;
-use super::traverse::Leaves;
+use super::traverse::{Leaves, prefetch};
 use super::triangles::{LANES, TriBlock, TriRay, UNUSED, intersect_block, is_storable};
 use crate::accel::bvh::BinnedSah;
 use crate::accel::bvh::build::parallel::fill_indexed;
@@ -360,26 +360,6 @@ pub(super) struct TriangleLeaves<'a, F> {
     pub(super) filter: F,
 }
 
-/// Starts loading block `first` of `blocks` into the cache (all three of its lines).
-#[inline(always)]
-pub(super) fn prefetch_block(blocks: &[TriBlock], first: u32) {
-    #[cfg(target_arch = "x86_64")]
-    {
-        // No bounds check: a prefetch never faults, whatever the address. A block is 160
-        // bytes, so its three lines start at 0, 64 and 128 bytes past its start.
-        let p = blocks.as_ptr().wrapping_add(first as usize) as *const i8;
-        // SAFETY: prefetching never dereferences: it neither faults nor reads into the program.
-        unsafe {
-            use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
-            for line in 0..3 {
-                _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(64 * line));
-            }
-        }
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    let _ = (blocks, first);
-}
-
 /// Keeps the hit on triangle `prim` in `best` if it is closer, or as close with a lower index
 /// (the rule of [`crate::accel::HitRecord::offer`]), and the filter accepts it; shrinks `t_max`
 /// to it.
@@ -438,7 +418,7 @@ impl<C: Counters, F: HitFilter<Hit>> Leaves<C> for TriangleLeaves<'_, F> {
 
     #[inline(always)]
     fn prefetch(&self, first: u32) {
-        prefetch_block(self.blocks, first);
+        prefetch(self.blocks, first);
     }
 
     #[inline(always)]

@@ -13,8 +13,8 @@ use super::packet_kernels::{Lanes, PACKET, PacketRays};
 #[cfg(target_arch = "x86_64")]
 use super::packet_triangles;
 use super::packet_triangles::{PacketBest, PacketTriRays};
-use super::traverse::Leaves;
-use super::triangle_bvh::{TriangleBvh, TriangleLeaves, prefetch_block};
+use super::traverse::{Leaves, prefetch};
+use super::triangle_bvh::{TriangleBvh, TriangleLeaves};
 use super::triangles::TriRay;
 use crate::accel::interface::batch::{run_batch_packets, run_packets};
 use crate::accel::{BatchSizeMismatch, Counters, Hit, NoCount, NoFilter};
@@ -179,7 +179,7 @@ impl<C: Counters> PacketLeaves<C> for TrianglePacket<'_> {
 
     #[inline(always)]
     fn prefetch(&self, first: u32) {
-        prefetch_block(self.bvh.blocks(), first);
+        prefetch(self.bvh.blocks(), first);
     }
 
     #[inline(never)]
