@@ -8,7 +8,8 @@
 //! closest hit, so the image is bit for bit the one a pixel-by-pixel render makes. What changes is
 //! the work counts (a packet visits the union of its rays' nodes), so renders that count their
 //! work, record a cost image, sample adaptively or skip pixels go pixel by pixel; so do worlds
-//! without a triangle tree (the teaching structures, instances alone), which have nothing to gain.
+//! that packets would not walk together ([`englobe::World::walks_packets`]: the teaching
+//! structures), which have nothing to gain.
 
 use englobe::{Counters, Ray, Vec3, WorldHit};
 
@@ -25,13 +26,13 @@ const _: () = assert!((BLOCK * BLOCK) as usize == PACKET, "a packet is a square 
 
 impl Renderer<'_> {
     /// Whether this render traces its primary rays in packets (see the module documentation):
-    /// only worlds whose meshes are in the fast path's triangle tree have something to gain.
+    /// only worlds on the fast path have something to gain.
     pub(crate) fn primary_packets(&self) -> bool {
         !self.count_work
             && !self.record_cost
             && self.supersampling.is_none()
             && self.stride == 1
-            && self.world.triangles().is_some()
+            && self.world.walks_packets()
     }
 
     /// The pixels of the tile `(x0, y0)..(x1, y1)`, row by row, primary rays traced in packets;

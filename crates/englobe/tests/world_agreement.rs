@@ -191,7 +191,7 @@ fn triangle_boxes(objects: &[Object]) -> Vec<Aabb> {
 }
 
 /// Every kind against brute force: the same hit bit for bit, the same any-hit answer, whether
-/// work is counted or not.
+/// work is counted or not, ray by ray, in packets and in batches.
 fn check(objects: Vec<Object>, rays: &[Ray]) -> Result<(), TestCaseError> {
     let brute = World::build(objects.clone(), AccelKind::None).expect("finite objects");
     let expected: Vec<(Option<WorldHit>, bool)> =
@@ -210,6 +210,20 @@ fn check(objects: Vec<Object>, rays: &[Ray]) -> Result<(), TestCaseError> {
             prop_assert_eq!(counted, got, "{}: counting changed the closest hit of {:?}", kind, ray);
             prop_assert_eq!(world.any_hit(ray, &mut NoCount), *any, "{}: any hit of {:?}", kind, ray);
             prop_assert_eq!(world.any_hit(ray, &mut WorkCounts::default()), *any, "{}: counted any hit", kind);
+        }
+        // Packets of sixteen consecutive rays (through the triangle tree and the top level
+        // together, on the fast path), coherent or not, and the batches that choose.
+        let (mut packet, mut batch) = (vec![None; rays.len()], vec![None; rays.len()]);
+        let (mut packet_any, mut batch_any) = (vec![false; rays.len()], vec![false; rays.len()]);
+        world.closest_hit_packet(rays, &mut packet, &mut WorkCounts::default()).expect("as many hits as rays");
+        world.any_hit_packet(rays, &mut packet_any, &mut NoCount).expect("as many answers as rays");
+        world.closest_hits(rays, &mut batch).expect("as many hits as rays");
+        world.any_hits(rays, &mut batch_any).expect("as many answers as rays");
+        for (i, (closest, any)) in expected.iter().enumerate() {
+            prop_assert_eq!(packet[i], *closest, "{}: packet closest hit of {:?}", kind, rays[i]);
+            prop_assert_eq!(batch[i], *closest, "{}: batch closest hit of {:?}", kind, rays[i]);
+            prop_assert_eq!(packet_any[i], *any, "{}: packet any hit of {:?}", kind, rays[i]);
+            prop_assert_eq!(batch_any[i], *any, "{}: batch any hit of {:?}", kind, rays[i]);
         }
     }
     Ok(())

@@ -1,12 +1,14 @@
 //! Batches and packets of a [`World`]'s two queries over slices of rays. A packet of up to
 //! sixteen rays walks the meshes' triangle tree together ([`TriangleBvh::closest_hit_packet`]),
-//! then each ray goes on alone through the shapes, the instances and the planes, exactly as its
-//! single-ray query does after the meshes: the same answers, ray for ray. Batches take sixteen
-//! rays at a time, in a packet when they are coherent, split across threads when large
+//! then the top level over the shapes and instances together (`packet.rs`: each ray tests the
+//! leaves it reaches alone), then each ray goes on alone through the planes, exactly as its
+//! single-ray query does: the same answers, ray for ray. Batches take sixteen rays at a time, in
+//! a packet when they are coherent, split across threads when large
 //! ([`crate::accel::interface::batch`]); no allocation per ray.
 //!
 //! [`TriangleBvh::closest_hit_packet`]: crate::TriangleBvh::closest_hit_packet
 
+use super::query::beats;
 use super::{World, WorldHit};
 use crate::Ray;
 use crate::accel::interface::batch::{run_batch_packets, run_packets};
@@ -77,10 +79,17 @@ impl World {
         run_packets(rays, mask, PACKET, |rays, mask| self.any_packet_of(rays, mask, counters))
     }
 
-    /// Whether `rays` are worth a packet: the world has meshes in its triangle tree, and the
-    /// rays are coherent at its scale.
+    /// Whether packet queries walk a structure of this world with their rays together: the fast
+    /// path's triangle tree, or its top level over shapes and instances. Otherwise
+    /// [`World::closest_hit_packet`] traces each ray alone, and a renderer may as well.
+    pub fn walks_packets(&self) -> bool {
+        self.triangles.is_some() || self.packet_top().is_some()
+    }
+
+    /// Whether `rays` are worth a packet: the world has a structure packets walk, and the rays
+    /// are coherent at its scale.
     fn coherent(&self, rays: &[Ray]) -> bool {
-        self.triangles.as_ref().is_some_and(|t| coherent(rays, &t.bounds()))
+        self.walks_packets() && coherent(rays, &self.bounds())
     }
 
     /// One packet of at most [`PACKET`] rays.
@@ -90,12 +99,34 @@ impl World {
         if let Some(t) = &self.triangles {
             t.closest_hit_packet(rays, meshes, counters).expect("as many places as rays");
         }
-        for ((h, ray), mesh) in hits.iter_mut().zip(rays).zip(meshes.iter()) {
-            *h = if ray.is_valid() {
-                self.closest_beyond_meshes(ray, mesh.map(|m| self.mesh_hit(m)), counters, &mut NoFilter)
-            } else {
-                None
-            };
+        let Some(top) = self.packet_top() else {
+            for ((h, ray), mesh) in hits.iter_mut().zip(rays).zip(meshes.iter()) {
+                *h = if ray.is_valid() {
+                    self.closest_beyond_meshes(ray, mesh.map(|m| self.mesh_hit(m)), counters, &mut NoFilter)
+                } else {
+                    None
+                };
+            }
+            return;
+        };
+        // The shapes and instances in a packet too, each ray up to its closest mesh hit.
+        let mut best = [None; PACKET];
+        let mut t_max = [0.0; PACKET];
+        for (i, (ray, mesh)) in rays.iter().zip(meshes.iter()).enumerate() {
+            best[i] = mesh.map(|m| self.mesh_hit(m));
+            t_max[i] = best[i].map_or(ray.t_max, |b: WorldHit| b.t);
+        }
+        let valid = valid_mask(rays);
+        let mut found = [None; PACKET];
+        let n = rays.len();
+        self.accel_closest_packet(top, rays, &t_max[..n], valid, &mut found[..n], counters);
+        for (i, (h, ray)) in hits.iter_mut().zip(rays).enumerate() {
+            if let Some(hit) = found[i]
+                && beats(&hit, best[i].as_ref())
+            {
+                best[i] = Some(hit);
+            }
+            *h = if valid >> i & 1 != 0 { self.closest_unbounded(ray, best[i], counters, &mut NoFilter) } else { None };
         }
     }
 
@@ -112,8 +143,23 @@ impl World {
                 *m |= hit;
             }
         }
+        if let Some(top) = self.packet_top() {
+            let pending = mask.iter().enumerate().fold(valid_mask(rays), |p, (i, &m)| p & !((m as u32) << i));
+            if pending != 0 {
+                let hit = self.accel_any_packet(top, rays, pending, counters);
+                for (i, m) in mask.iter_mut().enumerate() {
+                    *m |= hit >> i & 1 != 0;
+                }
+            }
+            return;
+        }
         for (m, ray) in mask.iter_mut().zip(rays) {
             *m = *m || (ray.is_valid() && self.any_in_accel(ray, counters, &mut NoFilter));
         }
     }
+}
+
+/// The valid rays of `rays` (at most [`PACKET`]), bit per ray.
+fn valid_mask(rays: &[Ray]) -> u32 {
+    rays.iter().enumerate().fold(0, |m, (i, r)| m | (r.is_valid() as u32) << i)
 }

@@ -34,6 +34,7 @@ mod batch;
 mod bottom;
 mod motion;
 mod object;
+mod packet;
 mod proximity;
 mod query;
 mod refit;

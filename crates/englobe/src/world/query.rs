@@ -12,12 +12,12 @@ use super::bottom::ClosestInstance;
 use super::{Object, World, WorldHit};
 use crate::PrimHit;
 use crate::Ray;
-use crate::accel::{Accel, Counters, Hit, HitFilter, NoFilter};
+use crate::accel::{Accel, Counters, Hit, HitFilter, NoCount, NoFilter};
 use crate::shapes::{Instance, Intersect, WatertightRay};
 
 /// Whether `hit` beats `best` under the rule of the module.
 #[inline(always)]
-fn beats(hit: &WorldHit, best: Option<&WorldHit>) -> bool {
+pub(super) fn beats(hit: &WorldHit, best: Option<&WorldHit>) -> bool {
     best.is_none_or(|b| hit.t < b.t || (hit.t == b.t && (hit.object, hit.prim) < (b.object, b.prim)))
 }
 
@@ -25,13 +25,13 @@ impl World {
     /// Whether [`World::accel`] holds anything (on the fast path, whether there are shapes or
     /// instances beside the meshes): a world of meshes and planes skips its query.
     #[inline(always)]
-    fn accel_in_use(&self) -> bool {
+    pub(super) fn accel_in_use(&self) -> bool {
         self.accel_prims.as_ref().is_none_or(|p| !p.is_empty())
     }
 
     /// The world's primitive number of primitive `i` of [`World::accel`].
     #[inline(always)]
-    fn accel_prim(&self, i: u32) -> u32 {
+    pub(super) fn accel_prim(&self, i: u32) -> u32 {
         self.accel_prims.as_ref().map_or(i, |p| p[i as usize])
     }
 
@@ -117,7 +117,7 @@ impl World {
 
     /// The closest hit of a valid `ray`, given `best`, the closest on the meshes' triangle tree:
     /// the shapes and instances, then the unbounded shapes.
-    #[inline]
+    #[inline(always)]
     pub(super) fn closest_beyond_meshes<C: Counters, F: HitFilter<WorldHit>>(
         &self,
         ray: &Ray,
@@ -131,6 +131,19 @@ impl World {
         {
             best = Some(hit);
         }
+        self.closest_unbounded(ray, best, counters, filter)
+    }
+
+    /// The closest hit of a valid `ray`, given `best`, the closest on the bounded primitives: the
+    /// unbounded shapes.
+    #[inline(always)]
+    pub(super) fn closest_unbounded<C: Counters, F: HitFilter<WorldHit>>(
+        &self,
+        ray: &Ray,
+        mut best: Option<WorldHit>,
+        counters: &mut C,
+        filter: &mut F,
+    ) -> Option<WorldHit> {
         if self.unbounded.is_empty() {
             return best;
         }
@@ -166,34 +179,61 @@ impl World {
         let mut watertight = None;
         let bounded = ray.with_range(ray.t_min, t_max);
         let found = self.accel.closest_hit(&bounded, counters, |i, r| {
-            let (object, local) = self.locate(self.accel_prim(i));
-            let h = match &self.objects[object as usize] {
-                Object::Shape(s) => s.intersect(r)?,
-                Object::Mesh(m) => {
-                    m.intersect_with(local, r, watertight.get_or_insert_with(|| WatertightRay::new(ray)))?
-                }
-                Object::Instance(inst) => {
-                    let hit = self.instance_closest_hit(object, inst, r, &mut nested, filter)?;
-                    instance_hits.offer(i, &hit);
-                    return Some(PrimHit { t: hit.t, u: hit.u, v: hit.v });
-                }
-            };
-            let candidate = WorldHit { t: h.t, object, prim: local, u: h.u, v: h.v };
-            (F::ACCEPTS_ALL || filter.accept(&candidate)).then_some(h)
+            self.accel_item_closest(i, r, &mut watertight, &mut nested, &mut instance_hits, filter)
         });
         counters.merge(&nested);
-        let h = found?;
+        Some(self.accel_world_hit(ray, found?, &instance_hits, filter))
+    }
+
+    /// The hit of `r` on primitive `i` of [`World::accel`] (what the structure's closure
+    /// answers): `r` is the query's ray shrunk to its closest hit so far. Work inside instances
+    /// is counted in `nested`, their hits kept in `instance_hits`; a plain mesh's triangle (the
+    /// teaching structures only) is tested with `watertight`, made at the first.
+    #[inline(always)]
+    pub(super) fn accel_item_closest<C: Counters, F: HitFilter<WorldHit>>(
+        &self,
+        i: u32,
+        r: &Ray,
+        watertight: &mut Option<WatertightRay>,
+        nested: &mut C,
+        instance_hits: &mut ClosestInstance,
+        filter: &mut F,
+    ) -> Option<PrimHit> {
+        let (object, local) = self.locate(self.accel_prim(i));
+        let h = match &self.objects[object as usize] {
+            Object::Shape(s) => s.intersect(r)?,
+            Object::Mesh(m) => m.intersect_with(local, r, watertight.get_or_insert_with(|| WatertightRay::new(r)))?,
+            Object::Instance(inst) => {
+                let hit = self.instance_closest_hit(object, inst, r, nested, filter)?;
+                instance_hits.offer(i, &hit);
+                return Some(PrimHit { t: hit.t, u: hit.u, v: hit.v });
+            }
+        };
+        let candidate = WorldHit { t: h.t, object, prim: local, u: h.u, v: h.v };
+        (F::ACCEPTS_ALL || filter.accept(&candidate)).then_some(h)
+    }
+
+    /// The world's name for `h`, the closest hit of `ray` on [`World::accel`]: an instance's hit
+    /// names its triangle, kept in `instance_hits`.
+    #[inline]
+    pub(super) fn accel_world_hit<F: HitFilter<WorldHit>>(
+        &self,
+        ray: &Ray,
+        h: Hit,
+        instance_hits: &ClosestInstance,
+        filter: &mut F,
+    ) -> WorldHit {
         let (object, local) = self.locate(self.accel_prim(h.prim));
         let prim = match &self.objects[object as usize] {
             Object::Instance(inst) => instance_hits.triangle(h.prim, h.t).unwrap_or_else(|| {
                 // Only a structure that breaks the tie rule of `HitRecord::offer` gets here:
                 // ask the instance again, up to the hit.
                 let r = ray.with_range(ray.t_min, h.t);
-                self.instance_closest_hit(object, inst, &r, &mut C::default(), filter).map_or(0, |x| x.prim)
+                self.instance_closest_hit(object, inst, &r, &mut NoCount, filter).map_or(0, |x| x.prim)
             }),
             _ => local,
         };
-        Some(WorldHit { t: h.t, object, prim, u: h.u, v: h.v })
+        WorldHit { t: h.t, object, prim, u: h.u, v: h.v }
     }
 
     /// [`World::any_hit`] counting only the hits `filter` accepts.
@@ -246,21 +286,30 @@ impl World {
         }
         let mut nested = C::default();
         let mut watertight = None;
-        let hit = self.accel.any_hit(ray, counters, |i, r| {
-            let (object, local) = self.locate(self.accel_prim(i));
-            let h = match &self.objects[object as usize] {
-                Object::Shape(s) => s.intersect(r),
-                Object::Mesh(m) => {
-                    m.intersect_with(local, r, watertight.get_or_insert_with(|| WatertightRay::new(ray)))
-                }
-                Object::Instance(inst) => return self.instance_any_hit(object, inst, r, &mut nested, filter),
-            };
-            h.is_some_and(|h| {
-                F::ACCEPTS_ALL || filter.accept(&WorldHit { t: h.t, object, prim: local, u: h.u, v: h.v })
-            })
-        });
+        let hit =
+            self.accel.any_hit(ray, counters, |i, r| self.accel_item_any(i, r, &mut watertight, &mut nested, filter));
         counters.merge(&nested);
         hit
+    }
+
+    /// Whether `r` hits primitive `i` of [`World::accel`] where `filter` accepts (see
+    /// [`World::accel_item_closest`]).
+    #[inline(always)]
+    pub(super) fn accel_item_any<C: Counters, F: HitFilter<WorldHit>>(
+        &self,
+        i: u32,
+        r: &Ray,
+        watertight: &mut Option<WatertightRay>,
+        nested: &mut C,
+        filter: &mut F,
+    ) -> bool {
+        let (object, local) = self.locate(self.accel_prim(i));
+        let h = match &self.objects[object as usize] {
+            Object::Shape(s) => s.intersect(r),
+            Object::Mesh(m) => m.intersect_with(local, r, watertight.get_or_insert_with(|| WatertightRay::new(r))),
+            Object::Instance(inst) => return self.instance_any_hit(object, inst, r, nested, filter),
+        };
+        h.is_some_and(|h| F::ACCEPTS_ALL || filter.accept(&WorldHit { t: h.t, object, prim: local, u: h.u, v: h.v }))
     }
 }
 

@@ -173,6 +173,48 @@ impl<C: Counters, F: FnMut(u32, &Ray) -> Option<PrimHit>> Leaves<C> for ClosureL
     }
 }
 
+impl WideBvh {
+    /// The single-ray closest-hit walk of the subtree of node `start` (an interior node), from
+    /// `record`: its ray and its closest hit so far; returns the record at the end. A packet walk
+    /// hands its rays over here when they go apart (see [`packet::PacketLeaves::alone`]).
+    #[inline]
+    pub(crate) fn closest_from<C: Counters>(
+        &self,
+        start: u32,
+        record: HitRecord,
+        counters: &mut C,
+        intersect: impl FnMut(u32, &Ray) -> Option<PrimHit>,
+    ) -> HitRecord {
+        let node_ray = NodeRay::new(&record.ray);
+        let mut leaves = ClosureLeaves { prims: &self.prim_indices, record, test: intersect };
+        dispatch::closest(self.isa, &self.nodes, self.depth, start, &node_ray, &mut leaves, counters);
+        leaves.record
+    }
+
+    /// The single-ray any-hit walk of the subtree of node `start` (see [`WideBvh::closest_from`]).
+    #[inline]
+    pub(crate) fn any_from<C: Counters>(
+        &self,
+        start: u32,
+        ray: &Ray,
+        counters: &mut C,
+        mut occludes: impl FnMut(u32, &Ray) -> bool,
+    ) -> bool {
+        let test = |prim: u32, r: &Ray| occludes(prim, r).then_some(PrimHit::at(0.0));
+        let mut leaves = ClosureLeaves { prims: &self.prim_indices, record: HitRecord::new(*ray), test };
+        dispatch::any(
+            self.isa,
+            &self.nodes,
+            self.depth,
+            start,
+            &NodeRay::new(ray),
+            reach(ray.t_max),
+            &mut leaves,
+            counters,
+        )
+    }
+}
+
 impl Accel for WideBvh {
     fn bounds(&self) -> Aabb {
         self.bounds
