@@ -7,7 +7,7 @@
 
 use super::dispatch;
 use super::isa::Isa;
-use super::node::{NodeRay, may_enter, reach};
+use super::node::{NodeRay, reach};
 use super::packet::{self, PacketLeaves};
 use super::packet_kernels::{Lanes, PACKET, PacketRays};
 #[cfg(target_arch = "x86_64")]
@@ -42,9 +42,8 @@ struct TrianglePacket<'a> {
 
 impl<'a> TrianglePacket<'a> {
     /// The state of a packet of `rays` (at least one; the lanes beyond them are never asked for),
-    /// of which `active` will be traced: no hit yet.
-    fn new(bvh: &'a TriangleBvh, rays: &'a [Ray], packet: &'a PacketRays, active: u32) -> Self {
-        let limits = Lanes(std::array::from_fn(|i| reach(rays.get(i).unwrap_or(&rays[0]).t_max)));
+    /// of which `active` will be traced, within `limits` (see [`reach`]): no hit yet.
+    fn new(bvh: &'a TriangleBvh, rays: &'a [Ray], packet: &'a PacketRays, limits: Lanes, active: u32) -> Self {
         // Only AVX-512 has the whole-packet triangle test.
         let decided = !(cfg!(target_arch = "x86_64") && bvh.isa() == Isa::Avx512);
         TrianglePacket { rays, packet, bvh, simd: None, decided, active, best: PacketBest::new(rays), limits }
@@ -211,13 +210,13 @@ impl<C: Counters> PacketLeaves<C> for TrianglePacket<'_> {
 }
 
 /// The rays of `rays` that may hit something in `bounds`, the tree's box: valid, and entering the
-/// box within their interval ([`may_enter`], which never refuses a ray that a child takes). The
-/// others cannot hit; a packet none of whose rays enters costs these few tests and nothing more
-/// (no packet state, no node), as a single ray that passes beside the box does.
-fn entering_mask(rays: &[Ray], bounds: &Aabb) -> u32 {
-    rays.iter()
-        .enumerate()
-        .fold(0, |m, (i, r)| m | ((r.is_valid() && may_enter(bounds, r, reach(r.t_max))) as u32) << i)
+/// box within their interval (`limits`, see [`reach`]), as [`super::node::may_enter`] tells it for
+/// a single ray (it never refuses a ray that a child takes). The others cannot hit; a packet none
+/// of whose rays enters costs these tests and nothing more (no node), as a single ray that passes
+/// beside the box does.
+fn entering_mask(rays: &[Ray], packet: &PacketRays, limits: &Lanes, bounds: &Aabb) -> u32 {
+    let valid = rays.iter().enumerate().fold(0, |m, (i, r)| m | (r.is_valid() as u32) << i);
+    valid & packet.may_enter(bounds, limits)
 }
 
 /// Whether `rays` are coherent enough to walk the tree together: directions within about 25
@@ -305,13 +304,14 @@ impl TriangleBvh {
             }
             return;
         }
-        let active = entering_mask(rays, &self.bounds());
+        let packet = PacketRays::new(rays);
+        let limits = Lanes(std::array::from_fn(|i| reach(rays.get(i).unwrap_or(&rays[0]).t_max)));
+        let active = entering_mask(rays, &packet, &limits, &self.bounds());
         if active == 0 {
             hits.fill(None);
             return;
         }
-        let packet = PacketRays::new(rays);
-        let mut leaves = TrianglePacket::new(self, rays, &packet, active);
+        let mut leaves = TrianglePacket::new(self, rays, &packet, limits, active);
         dispatch::closest_packet(self.isa(), self.nodes(), &packet, active, &mut leaves, counters);
         for (i, h) in hits.iter_mut().enumerate() {
             *h = leaves.hit(i);
@@ -330,13 +330,14 @@ impl TriangleBvh {
             }
             return;
         }
-        let active = entering_mask(rays, &self.bounds());
+        let packet = PacketRays::new(rays);
+        let limits = Lanes(std::array::from_fn(|i| reach(rays.get(i).unwrap_or(&rays[0]).t_max)));
+        let active = entering_mask(rays, &packet, &limits, &self.bounds());
         if active == 0 {
             mask.fill(false);
             return;
         }
-        let packet = PacketRays::new(rays);
-        let mut leaves = TrianglePacket::new(self, rays, &packet, active);
+        let mut leaves = TrianglePacket::new(self, rays, &packet, limits, active);
         let hit = dispatch::any_packet(self.isa(), self.nodes(), &packet, active, &mut leaves, counters);
         for (i, m) in mask.iter_mut().enumerate() {
             *m = hit >> i & 1 != 0;
