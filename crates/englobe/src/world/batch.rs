@@ -13,7 +13,7 @@ use super::{World, WorldHit};
 use crate::Ray;
 use crate::accel::interface::batch::{run_batch_packets, run_packets};
 use crate::accel::wide::packet_kernels::PACKET;
-use crate::accel::wide::triangle_packet::coherent;
+use crate::accel::wide::triangle_packet::{coherent, valid_mask};
 use crate::accel::{BatchSizeMismatch, Counters, NoCount, NoFilter};
 
 impl World {
@@ -94,72 +94,62 @@ impl World {
 
     /// One packet of at most [`PACKET`] rays.
     fn closest_packet_of<C: Counters>(&self, rays: &[Ray], hits: &mut [Option<WorldHit>], counters: &mut C) {
-        let mut meshes = [None; PACKET];
-        let meshes = &mut meshes[..rays.len()];
-        if let Some(t) = &self.triangles {
-            t.closest_hit_packet(rays, meshes, counters).expect("as many places as rays");
-        }
-        let Some(top) = self.packet_top() else {
-            for ((h, ray), mesh) in hits.iter_mut().zip(rays).zip(meshes.iter()) {
-                *h = if ray.is_valid() {
-                    self.closest_beyond_meshes(ray, mesh.map(|m| self.mesh_hit(m)), counters, &mut NoFilter)
-                } else {
-                    None
-                };
-            }
-            return;
-        };
-        // The shapes and instances in a packet too, each ray up to its closest mesh hit.
-        let mut best = [None; PACKET];
-        let mut t_max = [0.0; PACKET];
-        for (i, (ray, mesh)) in rays.iter().zip(meshes.iter()).enumerate() {
-            best[i] = mesh.map(|m| self.mesh_hit(m));
-            t_max[i] = best[i].map_or(ray.t_max, |b: WorldHit| b.t);
-        }
-        let valid = valid_mask(rays);
-        let mut found = [None; PACKET];
         let n = rays.len();
-        self.accel_closest_packet(top, rays, &t_max[..n], valid, &mut found[..n], counters);
-        for (i, (h, ray)) in hits.iter_mut().zip(rays).enumerate() {
-            if let Some(hit) = found[i]
-                && beats(&hit, best[i].as_ref())
-            {
-                best[i] = Some(hit);
+        let valid = valid_mask(rays);
+        let mut meshes = [None; PACKET];
+        if let Some(t) = &self.triangles {
+            t.closest_packet_among(rays, valid, &mut meshes[..n], counters);
+        }
+        let mut best: [Option<WorldHit>; PACKET] = std::array::from_fn(|i| meshes[i].map(|m| self.mesh_hit(m)));
+        let top = self.packet_top();
+        if let Some(top) = top {
+            // The shapes and instances in a packet too, each ray up to its closest mesh hit.
+            let t_max: [f32; PACKET] = std::array::from_fn(|i| best[i].map_or(rays[i.min(n - 1)].t_max, |b| b.t));
+            let mut found = [None; PACKET];
+            self.accel_closest_packet(top, rays, &t_max[..n], valid, &mut found[..n], counters);
+            for (b, hit) in best.iter_mut().zip(found) {
+                if let Some(hit) = hit
+                    && beats(&hit, b.as_ref())
+                {
+                    *b = Some(hit);
+                }
             }
-            *h = if valid >> i & 1 != 0 { self.closest_unbounded(ray, best[i], counters, &mut NoFilter) } else { None };
+        }
+        for (i, (h, ray)) in hits.iter_mut().zip(rays).enumerate() {
+            *h = if valid >> i & 1 == 0 {
+                None
+            } else if top.is_some() {
+                self.closest_unbounded(ray, best[i], counters, &mut NoFilter)
+            } else {
+                self.closest_beyond_meshes(ray, best[i], counters, &mut NoFilter)
+            };
         }
     }
 
     /// One packet of at most [`PACKET`] rays: the unbounded shapes first, as [`World::any_hit`]
     /// tests them, then the meshes for the rays still unblocked, then the rest.
     fn any_packet_of<C: Counters>(&self, rays: &[Ray], mask: &mut [bool], counters: &mut C) {
-        for (m, ray) in mask.iter_mut().zip(rays) {
-            *m = ray.is_valid() && self.any_unbounded(ray, counters, &mut NoFilter);
-        }
+        let valid = valid_mask(rays);
+        let mut blocked = (0..rays.len())
+            .filter(|&i| valid >> i & 1 != 0 && self.any_unbounded(&rays[i], counters, &mut NoFilter))
+            .fold(0u32, |m, i| m | 1 << i);
         if let Some(t) = &self.triangles {
-            let mut meshes = [false; PACKET];
-            t.any_hit_packet(rays, &mut meshes[..rays.len()], counters).expect("as many places as rays");
-            for (m, hit) in mask.iter_mut().zip(meshes) {
-                *m |= hit;
-            }
+            blocked |= t.any_packet_among(rays, valid & !blocked, counters);
         }
         if let Some(top) = self.packet_top() {
-            let pending = mask.iter().enumerate().fold(valid_mask(rays), |p, (i, &m)| p & !((m as u32) << i));
+            let pending = valid & !blocked;
             if pending != 0 {
-                let hit = self.accel_any_packet(top, rays, pending, counters);
-                for (i, m) in mask.iter_mut().enumerate() {
-                    *m |= hit >> i & 1 != 0;
+                blocked |= self.accel_any_packet(top, rays, pending, counters);
+            }
+        } else {
+            for (i, ray) in rays.iter().enumerate() {
+                if (valid & !blocked) >> i & 1 != 0 && self.any_in_accel(ray, counters, &mut NoFilter) {
+                    blocked |= 1 << i;
                 }
             }
-            return;
         }
-        for (m, ray) in mask.iter_mut().zip(rays) {
-            *m = *m || (ray.is_valid() && self.any_in_accel(ray, counters, &mut NoFilter));
+        for (i, m) in mask.iter_mut().enumerate() {
+            *m = blocked >> i & 1 != 0;
         }
     }
-}
-
-/// The valid rays of `rays` (at most [`PACKET`]), bit per ray.
-fn valid_mask(rays: &[Ray]) -> u32 {
-    rays.iter().enumerate().fold(0, |m, (i, r)| m | (r.is_valid() as u32) << i)
 }

@@ -209,14 +209,17 @@ impl<C: Counters> PacketLeaves<C> for TrianglePacket<'_> {
     }
 }
 
-/// The rays of `rays` that may hit something in `bounds`, the tree's box: valid, and entering the
-/// box within their interval (`limits`, see [`reach`]), as [`super::node::may_enter`] tells it for
-/// a single ray (it never refuses a ray that a child takes). The others cannot hit; a packet none
-/// of whose rays enters costs these tests and nothing more (no node), as a single ray that passes
-/// beside the box does.
-fn entering_mask(rays: &[Ray], packet: &PacketRays, limits: &Lanes, bounds: &Aabb) -> u32 {
-    let valid = rays.iter().enumerate().fold(0, |m, (i, r)| m | (r.is_valid() as u32) << i);
-    valid & packet.may_enter(bounds, limits)
+/// The valid rays of `rays` (at most [`PACKET`]), bit per ray ([`Ray::is_valid`]).
+pub(crate) fn valid_mask(rays: &[Ray]) -> u32 {
+    rays.iter().enumerate().fold(0, |m, (i, r)| m | (r.is_valid() as u32) << i)
+}
+
+/// How far each ray of `rays` (1 to [`PACKET`]) may enter a box ([`reach`] of its `t_max`); the
+/// lanes beyond copy the first. A packet drops the rays that pass beside the tree's box first
+/// ([`PacketRays::may_enter`] within these limits, as a single ray does): a packet none of whose
+/// rays enters costs that test and nothing more (no node).
+fn limits_of(rays: &[Ray]) -> Lanes {
+    Lanes(std::array::from_fn(|i| reach(rays.get(i).unwrap_or(&rays[0]).t_max)))
 }
 
 /// Whether `rays` are coherent enough to walk the tree together: directions within about 25
@@ -294,21 +297,33 @@ impl TriangleBvh {
 
     /// One packet of 1 to [`PACKET`] rays.
     fn closest_packet_of<C: Counters>(&self, rays: &[Ray], hits: &mut [Option<Hit>], counters: &mut C) {
+        self.closest_packet_among(rays, valid_mask(rays), hits, counters);
+    }
+
+    /// One packet of 1 to [`PACKET`] rays, of which those of `among` (bit per ray, valid rays
+    /// only: a world checks them once for all its structures) are traced; the others get no hit.
+    pub(crate) fn closest_packet_among<C: Counters>(
+        &self,
+        rays: &[Ray],
+        among: u32,
+        hits: &mut [Option<Hit>],
+        counters: &mut C,
+    ) {
         debug_assert!(rays.len() <= PACKET && rays.len() == hits.len());
-        if rays.is_empty() {
+        hits.fill(None);
+        if among == 0 || self.nodes().is_empty() {
             return;
         }
-        if self.nodes().is_empty() || !packet::fits(self.depth()) {
-            for (h, r) in hits.iter_mut().zip(rays) {
-                *h = self.closest_hit(r, counters);
+        if !packet::fits(self.depth()) {
+            for i in (0..rays.len()).filter(|&i| among >> i & 1 != 0) {
+                hits[i] = self.closest_hit_of_valid(&rays[i], counters, NoFilter);
             }
             return;
         }
         let packet = PacketRays::new(rays);
-        let limits = Lanes(std::array::from_fn(|i| reach(rays.get(i).unwrap_or(&rays[0]).t_max)));
-        let active = entering_mask(rays, &packet, &limits, &self.bounds());
+        let limits = limits_of(rays);
+        let active = among & packet.may_enter(&self.bounds(), &limits);
         if active == 0 {
-            hits.fill(None);
             return;
         }
         let mut leaves = TrianglePacket::new(self, rays, &packet, limits, active);
@@ -321,26 +336,30 @@ impl TriangleBvh {
     /// One packet of 1 to [`PACKET`] rays.
     fn any_packet_of<C: Counters>(&self, rays: &[Ray], mask: &mut [bool], counters: &mut C) {
         debug_assert!(rays.len() <= PACKET && rays.len() == mask.len());
-        if rays.is_empty() {
-            return;
-        }
-        if self.nodes().is_empty() || !packet::fits(self.depth()) {
-            for (m, r) in mask.iter_mut().zip(rays) {
-                *m = self.any_hit(r, counters);
-            }
-            return;
-        }
-        let packet = PacketRays::new(rays);
-        let limits = Lanes(std::array::from_fn(|i| reach(rays.get(i).unwrap_or(&rays[0]).t_max)));
-        let active = entering_mask(rays, &packet, &limits, &self.bounds());
-        if active == 0 {
-            mask.fill(false);
-            return;
-        }
-        let mut leaves = TrianglePacket::new(self, rays, &packet, limits, active);
-        let hit = dispatch::any_packet(self.isa(), self.nodes(), &packet, active, &mut leaves, counters);
+        let hit = self.any_packet_among(rays, valid_mask(rays), counters);
         for (i, m) in mask.iter_mut().enumerate() {
             *m = hit >> i & 1 != 0;
         }
+    }
+
+    /// The rays of `among` (valid rays of a packet of 1 to [`PACKET`]) that hit something.
+    pub(crate) fn any_packet_among<C: Counters>(&self, rays: &[Ray], among: u32, counters: &mut C) -> u32 {
+        debug_assert!(rays.len() <= PACKET);
+        if among == 0 || self.nodes().is_empty() {
+            return 0;
+        }
+        if !packet::fits(self.depth()) {
+            return (0..rays.len())
+                .filter(|&i| among >> i & 1 != 0 && self.any_hit_of_valid(&rays[i], counters, NoFilter))
+                .fold(0, |m, i| m | 1 << i);
+        }
+        let packet = PacketRays::new(rays);
+        let limits = limits_of(rays);
+        let active = among & packet.may_enter(&self.bounds(), &limits);
+        if active == 0 {
+            return 0;
+        }
+        let mut leaves = TrianglePacket::new(self, rays, &packet, limits, active);
+        dispatch::any_packet(self.isa(), self.nodes(), &packet, active, &mut leaves, counters)
     }
 }
