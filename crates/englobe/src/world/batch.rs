@@ -95,6 +95,9 @@ impl World {
     /// One packet of at most [`PACKET`] rays.
     fn closest_packet_of<C: Counters>(&self, rays: &[Ray], hits: &mut [Option<WorldHit>], counters: &mut C) {
         let n = rays.len();
+        if n == 0 {
+            return;
+        }
         let valid = valid_mask(rays);
         let mut meshes = [None; PACKET];
         if let Some(t) = &self.triangles {

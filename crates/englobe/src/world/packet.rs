@@ -53,6 +53,7 @@ impl<'a> TopPacket<'a> {
     /// for): no hit yet.
     fn new(world: &'a World, top: &'a WideBvh, rays: &[Ray]) -> Self {
         let len = rays.len();
+        debug_assert!((1..=PACKET).contains(&len), "a packet holds 1 to {PACKET} rays");
         let ray = |i: usize| rays[i.min(len - 1)];
         TopPacket {
             world,
