@@ -70,10 +70,8 @@ impl<C: Counters> PacketLeaves<C> for TopPacket<'_> {
     fn closest(&mut self, first: u32, count: u32, rays: u32, counters: &mut C) {
         let world = self.world;
         for &i in &self.top.prim_indices()[first as usize..(first + count) as usize] {
-            for _ in 0..rays.count_ones() {
-                counters.exact_test();
-            }
             for l in lanes(rays) {
+                counters.exact_test();
                 let (record, instances) = (&mut self.records[l], &mut self.instances[l]);
                 if let Some(hit) =
                     world.accel_item_closest(i, &record.ray, &mut None, counters, instances, &mut NoFilter)
@@ -94,10 +92,8 @@ impl<C: Counters> PacketLeaves<C> for TopPacket<'_> {
             if pending == 0 {
                 break;
             }
-            for _ in 0..pending.count_ones() {
-                counters.exact_test();
-            }
             for l in lanes(pending) {
+                counters.exact_test();
                 if world.accel_item_any(i, &self.records[l].ray, &mut None, counters, &mut NoFilter) {
                     found |= 1 << l;
                 }

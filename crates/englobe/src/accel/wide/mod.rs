@@ -174,9 +174,10 @@ impl<C: Counters, F: FnMut(u32, &Ray) -> Option<PrimHit>> Leaves<C> for ClosureL
 }
 
 impl WideBvh {
-    /// The single-ray closest-hit walk of the subtree of node `start` (an interior node), from
-    /// `record`: its ray and its closest hit so far; returns the record at the end. A packet walk
-    /// hands its rays over here when they go apart (see [`packet::PacketLeaves::alone`]).
+    /// The single-ray closest-hit walk of the subtree of node `start` (an interior node) from
+    /// `record`: its ray, valid, and its closest hit so far; returns the record at the end. A
+    /// whole query starts at the root; a packet walk hands its rays over here when they go apart
+    /// (see [`packet::PacketLeaves::alone`]).
     #[inline]
     pub(crate) fn closest_from<C: Counters>(
         &self,
@@ -230,19 +231,15 @@ impl Accel for WideBvh {
         if !ray.is_valid() || self.nodes.is_empty() {
             return None;
         }
-        let mut leaves = ClosureLeaves { prims: &self.prim_indices, record: HitRecord::new(*ray), test: intersect };
-        dispatch::closest(self.isa, &self.nodes, self.depth, 0, &NodeRay::new(ray), &mut leaves, counters);
-        leaves.record.hit
+        self.closest_from(0, HitRecord::new(*ray), counters, intersect).hit
     }
 
     #[inline]
-    fn any_hit<C: Counters>(&self, ray: &Ray, counters: &mut C, mut occludes: impl FnMut(u32, &Ray) -> bool) -> bool {
+    fn any_hit<C: Counters>(&self, ray: &Ray, counters: &mut C, occludes: impl FnMut(u32, &Ray) -> bool) -> bool {
         if !ray.is_valid() || self.nodes.is_empty() {
             return false;
         }
-        let test = |prim: u32, r: &Ray| occludes(prim, r).then_some(PrimHit::at(0.0));
-        let mut leaves = ClosureLeaves { prims: &self.prim_indices, record: HitRecord::new(*ray), test };
-        dispatch::any(self.isa, &self.nodes, self.depth, 0, &NodeRay::new(ray), reach(ray.t_max), &mut leaves, counters)
+        self.any_from(0, ray, counters, occludes)
     }
 
     fn stats(&self) -> StructureStats {
