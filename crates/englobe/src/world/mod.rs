@@ -41,7 +41,7 @@ mod refit;
 
 use crate::PrimHit;
 use crate::accel::{Accel, AccelKind, AnyAccel, MAX_PRIMITIVES, StructureStats, TriangleBvh};
-use crate::shapes::{Bounded, Intersect, Shape, clip_triangle};
+use crate::shapes::{Bounded, Intersect, Plane, Shape, clip_triangle};
 use crate::{Aabb, Ray};
 
 pub use bottom::BottomLevel;
@@ -153,8 +153,10 @@ pub struct World {
     prim_object: Vec<u32>,
     /// For each object, the number of its first primitive.
     object_first_prim: Vec<u32>,
-    /// Objects tested beside the structures.
-    unbounded: Vec<u32>,
+    /// The unbounded shapes (planes, the only kind), tested beside the structures: each with its
+    /// object number, held here by value so that every query tests them without a lookup or a
+    /// dispatch on the shape's kind.
+    unbounded: Vec<(u32, Plane)>,
     kind: AccelKind,
     /// The structure over the primitives that are not in [`World::triangles`].
     accel: AnyAccel,
@@ -205,7 +207,7 @@ impl World {
         for (i, object) in objects.iter().enumerate() {
             object_first_prim.push(boxes.len() as u32);
             match object {
-                Object::Shape(s) if !s.is_bounded() => unbounded.push(i as u32),
+                Object::Shape(Shape::Plane(p)) => unbounded.push((i as u32, *p)),
                 Object::Shape(s) => {
                     let b = s.bounds();
                     if !b.is_finite() {

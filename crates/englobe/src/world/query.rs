@@ -148,10 +148,10 @@ impl World {
             return best;
         }
         let mut bounded = ray.with_range(ray.t_min, best.map_or(ray.t_max, |b| b.t));
-        for &object in &self.unbounded {
+        for (object, plane) in &self.unbounded {
             counters.exact_test();
-            let Object::Shape(shape) = &self.objects[object as usize] else { continue };
-            if let Some(h) = shape.intersect(&bounded) {
+            if let Some(h) = plane.intersect(&bounded) {
+                let object = *object;
                 let hit = WorldHit { t: h.t, object, prim: 0, u: h.u, v: h.v };
                 if beats(&hit, best.as_ref()) && (F::ACCEPTS_ALL || filter.accept(&hit)) {
                     bounded.t_max = h.t;
@@ -262,14 +262,11 @@ impl World {
         counters: &mut C,
         filter: &mut F,
     ) -> bool {
-        self.unbounded.iter().any(|&object| {
+        self.unbounded.iter().any(|&(object, plane)| {
             counters.exact_test();
-            match &self.objects[object as usize] {
-                Object::Shape(s) => s.intersect(ray).is_some_and(|h| {
-                    F::ACCEPTS_ALL || filter.accept(&WorldHit { t: h.t, object, prim: 0, u: h.u, v: h.v })
-                }),
-                Object::Mesh(_) | Object::Instance(_) => false,
-            }
+            plane
+                .intersect(ray)
+                .is_some_and(|h| F::ACCEPTS_ALL || filter.accept(&WorldHit { t: h.t, object, prim: 0, u: h.u, v: h.v }))
         })
     }
 

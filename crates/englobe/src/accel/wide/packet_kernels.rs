@@ -49,7 +49,7 @@ pub struct PacketRays {
 impl PacketRays {
     /// Prepares up to [`PACKET`] rays; the lanes beyond `rays.len()` hold zeros, and no query may
     /// ask for them.
-    #[inline]
+    #[inline(always)]
     pub fn new(rays: &[Ray]) -> Self {
         debug_assert!(rays.len() <= PACKET);
         let zero = Lanes([0.0; PACKET]);
