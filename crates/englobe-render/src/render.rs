@@ -355,7 +355,7 @@ impl<'a> Renderer<'a> {
 
     /// The camera ray through the point `(dx, dy)` of pixel `(x, y)` (see
     /// [`Renderer::sample_at`]).
-    #[inline]
+    #[inline(always)]
     pub(crate) fn camera_ray(
         &self,
         camera: &ImageCamera,
