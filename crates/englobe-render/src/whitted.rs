@@ -112,6 +112,11 @@ impl<'a> Whitted<'a> {
         let n = rays.len();
         assert!(n <= PACKET && hits.len() == n && out.len() == n, "a packet holds at most {PACKET} rays");
         tally.rays[RayKind::Primary as usize] += n as u64;
+        // The hits' triangles are loaded together first: one after the other, their cache
+        // misses (the triangle tree keeps its own copies of the vertices) would add up.
+        for hit in hits.iter().flatten() {
+            self.world.prefetch_shading(hit);
+        }
         // Filled in place: a surface is large, and copies of it cost more than its shading.
         let mut surfaces: [Option<Surface>; PACKET] = std::array::from_fn(|_| None);
         for ((slot, ray), hit) in surfaces.iter_mut().zip(rays).zip(hits) {

@@ -3,6 +3,7 @@
 //! nothing of the crate.
 
 pub mod aabb;
+pub mod prefetch;
 pub mod prim_hit;
 pub mod ray;
 

@@ -6,6 +6,7 @@ use glam::{Vec2, Vec3};
 use super::Triangle;
 use super::triangle::{WatertightRay, intersect_triangle};
 use crate::PrimHit;
+use crate::geom::prefetch::prefetch;
 use crate::{Aabb, Ray};
 
 /// Why a mesh was refused.
@@ -265,6 +266,19 @@ impl TriangleMesh {
         (b - a).cross(c - a).normalize_or_zero()
     }
 
+    /// Starts loading what shading triangle `i` reads (its vertices, and their normals if the
+    /// mesh has them; see [`crate::World::prefetch_shading`]).
+    #[inline]
+    pub fn prefetch_triangle(&self, i: u32) {
+        let Some(&[a, b, c]) = self.triangles.get(i as usize) else { return };
+        for v in [a, b, c] {
+            prefetch(&self.positions, v);
+            if let Some(normals) = &self.normals {
+                prefetch(normals, v);
+            }
+        }
+    }
+
     /// The normal for shading at barycentric `(u, v)` on triangle `i`: interpolated from the
     /// vertex normals when the mesh has them, the geometric normal otherwise.
     pub fn shading_normal(&self, i: u32, u: f32, v: f32) -> Vec3 {
@@ -321,5 +335,18 @@ mod tests {
         assert_eq!(n, Vec3::X);
         let n = m.shading_normal(0, 0.0, 0.5);
         assert!((n - Vec3::new(1.0, 0.0, 1.0).normalize()).length() < 1e-6);
+    }
+
+    #[test]
+    fn prefetching_is_a_hint_for_any_index() {
+        // A hint reads nothing into the program: the mesh answers the same after it, and an index
+        // past the end (or the largest) is no error.
+        let m = quad().with_normals(vec![Vec3::Z; 4]).unwrap();
+        for i in [0, 1, 2, u32::MAX] {
+            m.prefetch_triangle(i);
+            quad().prefetch_triangle(i);
+        }
+        assert_eq!(m.geometric_normal(1), Vec3::Z);
+        assert_eq!(m.shading_normal(0, 0.2, 0.3), Vec3::Z);
     }
 }
