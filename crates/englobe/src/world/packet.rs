@@ -50,7 +50,9 @@ fn lanes(mut mask: u32) -> impl Iterator<Item = usize> {
 
 impl<'a> TopPacket<'a> {
     /// The state of 1 to [`PACKET`] rays (the lanes beyond hold copies of the last, never asked
-    /// for): no hit yet.
+    /// for): no hit yet. Inlined, so that the state (over a kilobyte) is built where the query
+    /// keeps it rather than copied there.
+    #[inline(always)]
     fn new(world: &'a World, top: &'a WideBvh, rays: &[Ray]) -> Self {
         let len = rays.len();
         debug_assert!((1..=PACKET).contains(&len), "a packet holds 1 to {PACKET} rays");
