@@ -104,13 +104,17 @@ pub struct TriangleMesh {
     uvs: Option<Vec<Vec2>>,
     /// The second set: `None` unless a loader keeps one, so that meshes with one set pay nothing.
     uvs1: Option<Vec<Vec2>>,
+    /// The box of the positions, kept: every instance of the mesh asks for it, and a scene may
+    /// place a mesh of a million vertices thousands of times.
+    bounds: Aabb,
 }
 
 impl TriangleMesh {
     /// A mesh from vertex positions and triangles (vertex indices, counter-clockwise).
     pub fn new(positions: Vec<Vec3>, triangles: Vec<[u32; 3]>) -> Result<Self, MeshError> {
         check_mesh(&positions, &triangles)?;
-        Ok(TriangleMesh { positions, triangles, normals: None, uvs: None, uvs1: None })
+        let bounds = Aabb::from_points(positions.iter().copied());
+        Ok(TriangleMesh { positions, triangles, normals: None, uvs: None, uvs1: None, bounds })
     }
 
     /// A mesh from plain arrays: vertex positions as `[x, y, z]` and triangles as three vertex
@@ -129,13 +133,9 @@ impl TriangleMesh {
     /// ```
     pub fn from_arrays(vertices: &[[f32; 3]], triangles: &[[u32; 3]]) -> Result<Self, MeshError> {
         check_arrays(vertices, triangles)?;
-        Ok(TriangleMesh {
-            positions: vertices.iter().map(|&p| Vec3::from_array(p)).collect(),
-            triangles: triangles.to_vec(),
-            normals: None,
-            uvs: None,
-            uvs1: None,
-        })
+        let positions: Vec<Vec3> = vertices.iter().map(|&p| Vec3::from_array(p)).collect();
+        let bounds = Aabb::from_points(positions.iter().copied());
+        Ok(TriangleMesh { positions, triangles: triangles.to_vec(), normals: None, uvs: None, uvs1: None, bounds })
     }
 
     /// [`TriangleMesh::from_arrays`] from flat arrays, as graphics APIs and file formats hand
@@ -240,9 +240,9 @@ impl TriangleMesh {
         Aabb::from_points(self.triangle(i).vertices)
     }
 
-    /// Bounding box of the whole mesh.
+    /// Bounding box of the whole mesh (of all its positions).
     pub fn bounds(&self) -> Aabb {
-        Aabb::from_points(self.positions.iter().copied())
+        self.bounds
     }
 
     /// The watertight test of the ray against triangle `i`.
