@@ -215,15 +215,10 @@ pub fn run_compare(
     // machine one render of a fraction of a second says little. The structures take turns, round
     // after round, so that a busy spell of the machine slows them all rather than one.
     progress("timing...");
-    loop {
-        let mut again = false;
+    while measured.iter().any(|m| m.timing.wants_another()) {
         for m in measured.iter_mut().filter(|m| m.timing.wants_another()) {
             let seconds = pool.install(|| render(scene, &m.world, m.settings))?.seconds;
             m.timing.add(seconds);
-            again = true;
-        }
-        if !again {
-            break;
         }
     }
     let mut rows: Vec<CompareRow> = measured.into_iter().map(|m| m.timing.fill(m.row)).collect();

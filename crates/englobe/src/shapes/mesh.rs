@@ -113,8 +113,13 @@ impl TriangleMesh {
     /// A mesh from vertex positions and triangles (vertex indices, counter-clockwise).
     pub fn new(positions: Vec<Vec3>, triangles: Vec<[u32; 3]>) -> Result<Self, MeshError> {
         check_mesh(&positions, &triangles)?;
+        Ok(Self::checked(positions, triangles))
+    }
+
+    /// A mesh of positions and triangles already checked, its box computed once.
+    fn checked(positions: Vec<Vec3>, triangles: Vec<[u32; 3]>) -> Self {
         let bounds = Aabb::from_points(positions.iter().copied());
-        Ok(TriangleMesh { positions, triangles, normals: None, uvs: None, uvs1: None, bounds })
+        TriangleMesh { positions, triangles, normals: None, uvs: None, uvs1: None, bounds }
     }
 
     /// A mesh from plain arrays: vertex positions as `[x, y, z]` and triangles as three vertex
@@ -133,9 +138,7 @@ impl TriangleMesh {
     /// ```
     pub fn from_arrays(vertices: &[[f32; 3]], triangles: &[[u32; 3]]) -> Result<Self, MeshError> {
         check_arrays(vertices, triangles)?;
-        let positions: Vec<Vec3> = vertices.iter().map(|&p| Vec3::from_array(p)).collect();
-        let bounds = Aabb::from_points(positions.iter().copied());
-        Ok(TriangleMesh { positions, triangles: triangles.to_vec(), normals: None, uvs: None, uvs1: None, bounds })
+        Ok(Self::checked(vertices.iter().map(|&p| Vec3::from_array(p)).collect(), triangles.to_vec()))
     }
 
     /// [`TriangleMesh::from_arrays`] from flat arrays, as graphics APIs and file formats hand

@@ -24,6 +24,7 @@ use std::mem::MaybeUninit;
 use super::kernels::NodeKernel;
 use super::node::{NodeRay, WIDTH, WideNode, index_of, is_leaf, reach};
 use crate::accel::Counters;
+use crate::geom::prefetch::prefetch;
 
 /// Depth (in wide nodes) up to which the stack lives on the call stack.
 pub const INLINE_DEPTH: usize = 32;
@@ -79,8 +80,6 @@ pub(super) fn prefetch_children_of(nodes: &[WideNode], node: &WideNode, mut mask
         }
     }
 }
-
-pub(super) use crate::geom::prefetch::prefetch;
 
 thread_local! {
     /// The stack of queries on trees deeper than [`INLINE_DEPTH`], reused from query to query. A

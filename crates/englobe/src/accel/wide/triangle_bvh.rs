@@ -13,11 +13,12 @@ use super::dispatch;
 use super::isa::{Isa, IsaUnavailable};
 use super::node::{NodeRay, WideNode, may_enter, reach};
 use super::presplit::presplit;
-use super::traverse::{Leaves, prefetch};
+use super::traverse::Leaves;
 use super::triangles::{LANES, TriBlock, TriRay, UNUSED, intersect_block, is_storable};
 use crate::accel::bvh::BinnedSah;
 use crate::accel::bvh::build::parallel::fill_indexed;
 use crate::accel::{Counters, Hit, HitFilter, LEAF_SIZE_BUCKETS, MAX_PRIMITIVES, NoFilter, StructureStats};
+use crate::geom::prefetch::prefetch;
 use crate::shapes::{MeshError, TriangleMesh, check_arrays};
 use crate::{Aabb, Ray};
 

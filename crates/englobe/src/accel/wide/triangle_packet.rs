@@ -13,11 +13,12 @@ use super::packet_kernels::{Lanes, PACKET, PacketRays};
 #[cfg(target_arch = "x86_64")]
 use super::packet_triangles;
 use super::packet_triangles::{PacketBest, PacketTriRays};
-use super::traverse::{Leaves, prefetch};
+use super::traverse::Leaves;
 use super::triangle_bvh::{TriangleBvh, TriangleLeaves};
 use super::triangles::TriRay;
 use crate::accel::interface::batch::{run_batch_packets, run_packets};
 use crate::accel::{BatchSizeMismatch, Counters, Hit, NoCount, NoFilter};
+use crate::geom::prefetch::prefetch;
 use crate::{Aabb, Ray};
 
 /// The rays of a packet and their closest hits so far, as structures of arrays. With AVX-512 and
