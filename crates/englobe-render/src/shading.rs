@@ -53,7 +53,7 @@ impl<'a> Surface<'a> {
         let material = &scene.materials[object.material_of(hit.prim) as usize];
         let p = world.hit_point(ray, hit);
         let d = ray.dir().normalize();
-        let geometric = world.geometric_normal(hit, p);
+        let (geometric, mut shading) = world.normals(hit, p);
         let entering = d.dot(geometric) < 0.0;
         let n = if entering { geometric } else { -geometric };
         // Set 1 is interpolated only for materials that read it; each set gets its own
@@ -71,8 +71,9 @@ impl<'a> Surface<'a> {
             }
         }
         let params = material.evaluate_at(&scene.textures, &coords);
-        let mut shading = world.shading_normal(hit, p);
-        if let (Some(bent), Some(tangent)) = (params.normal_ts, object.tangent(hit.prim, hit.u, hit.v)) {
+        if let Some(bent) = params.normal_ts
+            && let Some(tangent) = object.tangent(hit.prim, hit.u, hit.v)
+        {
             let (t, w) = match &world.objects()[hit.object as usize] {
                 Object::Instance(inst) => {
                     let m = inst.to_world();

@@ -286,9 +286,25 @@ impl TriangleMesh {
     /// vertex normals when the mesh has them, the geometric normal otherwise.
     pub fn shading_normal(&self, i: u32, u: f32, v: f32) -> Vec3 {
         let Some(normals) = &self.normals else { return self.geometric_normal(i) };
+        self.interpolated_normal(normals, i, u, v).unwrap_or_else(|| self.geometric_normal(i))
+    }
+
+    /// Both normals of triangle `i` at barycentric `(u, v)`: the geometric normal, and the
+    /// shading normal if it differs from it (the mesh has vertex normals and they do not cancel
+    /// out there). The same numbers as [`TriangleMesh::geometric_normal`] and
+    /// [`TriangleMesh::shading_normal`], the triangle read once.
+    #[inline]
+    pub fn normals_at(&self, i: u32, u: f32, v: f32) -> (Vec3, Option<Vec3>) {
+        let geometric = self.geometric_normal(i);
+        (geometric, self.normals.as_ref().and_then(|normals| self.interpolated_normal(normals, i, u, v)))
+    }
+
+    /// The vertex normals of triangle `i` interpolated at `(u, v)` and normalised, if they do not
+    /// cancel out.
+    #[inline]
+    fn interpolated_normal(&self, normals: &[Vec3], i: u32, u: f32, v: f32) -> Option<Vec3> {
         let [a, b, c] = self.triangles[i as usize];
-        let n = normals[a as usize] * (1.0 - u - v) + normals[b as usize] * u + normals[c as usize] * v;
-        n.try_normalize().unwrap_or_else(|| self.geometric_normal(i))
+        (normals[a as usize] * (1.0 - u - v) + normals[b as usize] * u + normals[c as usize] * v).try_normalize()
     }
 }
 

@@ -144,7 +144,7 @@ impl World {
             if pending != 0 {
                 blocked |= self.accel_any_packet(top, rays, pending, counters);
             }
-        } else {
+        } else if self.accel_in_use() {
             for (i, ray) in rays.iter().enumerate() {
                 if (valid & !blocked) >> i & 1 != 0 && self.any_in_accel(ray, counters, &mut NoFilter) {
                     blocked |= 1 << i;

@@ -365,6 +365,28 @@ impl World {
         }
     }
 
+    /// Both normals at `hit`, `(geometric, shading)`: the same numbers as
+    /// [`World::geometric_normal`] and [`World::shading_normal`], the object looked up once and a
+    /// flat surface's normal computed once (a renderer needs both at every hit).
+    #[inline]
+    pub fn normals(&self, hit: &WorldHit, p: Vec3) -> (Vec3, Vec3) {
+        match &self.objects[hit.object as usize] {
+            Object::Shape(s) => {
+                let n = s.normal(p, &PrimHit { t: hit.t, u: hit.u, v: hit.v });
+                (n, n)
+            }
+            Object::Mesh(m) => {
+                let (geometric, shading) = m.normals_at(hit.prim, hit.u, hit.v);
+                (geometric, shading.unwrap_or(geometric))
+            }
+            Object::Instance(i) => {
+                let (geometric, shading) = i.mesh().normals_at(hit.prim, hit.u, hit.v);
+                let geometric = i.normal_to_world(geometric);
+                (geometric, shading.map_or(geometric, |n| i.normal_to_world(n)))
+            }
+        }
+    }
+
     /// Starts loading into the cache what [`World::geometric_normal`] and
     /// [`World::shading_normal`] will read for `hit` (a mesh triangle's vertices and normals).
     /// A renderer with several hits to shade calls it for all of them first, so that their cache
