@@ -29,7 +29,7 @@ use crate::light_sampling::SampledLights;
 use crate::optics::{fresnel_dielectric, reflect, refract};
 use crate::ray_cone::RayCone;
 use crate::sampling::cosine_hemisphere;
-use crate::shading::{SHADOW_RAY_END, Surface};
+use crate::shading::{PlainMaterials, SHADOW_RAY_END, Surface};
 use crate::stats::{RayKind, Tally};
 use crate::visibility::Visibility;
 
@@ -44,6 +44,7 @@ pub struct PathTracer<'a> {
     emitters: Emitters,
     lights: SampledLights,
     cone: Option<RayCone>,
+    plain: PlainMaterials,
 }
 
 /// Where a path goes from a hit: the next ray, its kind, the factor on the throughput and the
@@ -65,6 +66,7 @@ impl<'a> PathTracer<'a> {
             emitters: Emitters::of(scene),
             lights: SampledLights::of(scene),
             cone: None,
+            plain: PlainMaterials::new(scene),
         }
     }
 
@@ -261,7 +263,7 @@ impl<'a> PathTracer<'a> {
                 break;
             };
             let cone = if depth == 0 { self.cone } else { None };
-            let s = Surface::at_over(self.scene, self.world, &ray, &hit, cone);
+            let s = Surface::at_over(self.scene, &self.plain, self.world, &ray, &hit, cone);
             // Surfaces emit from their front side only (outward normal, or the winding's normal),
             // as physical lamps do.
             let emission = s.params.emission;

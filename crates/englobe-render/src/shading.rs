@@ -20,6 +20,37 @@ use crate::visibility::Visibility;
 /// Shadow rays toward a point light stop this fraction short of it.
 pub(crate) const SHADOW_RAY_END: f32 = 1.0 - 1e-4;
 
+/// The parameters of a scene's materials that have no texture, by material index: they are the
+/// same at every hit, so an integrator works them out once rather than at each (where the
+/// roughness alone costs a division and two square roots, one waiting on the other).
+#[derive(Clone, Debug, Default)]
+pub struct PlainMaterials {
+    params: Vec<Option<SurfaceParams>>,
+}
+
+impl PlainMaterials {
+    /// The untextured materials' parameters of `scene`.
+    pub fn new(scene: &Scene) -> Self {
+        let params = scene
+            .materials
+            .iter()
+            .map(|m| m.textures.is_empty().then(|| m.evaluate_at(&scene.textures, &TexCoords::default())))
+            .collect();
+        PlainMaterials { params }
+    }
+
+    /// No material's: every hit evaluates its material.
+    pub fn none() -> Self {
+        PlainMaterials::default()
+    }
+
+    /// The parameters of material `index`, if it has no texture and is known here.
+    #[inline]
+    pub fn get(&self, index: u32) -> Option<SurfaceParams> {
+        self.params.get(index as usize).copied().flatten()
+    }
+}
+
 /// A hit, ready for shading.
 pub struct Surface<'a> {
     /// The hit point (moved back onto the surface where the shape allows).
@@ -43,14 +74,23 @@ impl<'a> Surface<'a> {
     /// coordinates (each in the set it names), the shading normal bent by its normal map (in the
     /// frame of the mesh's tangents, moved into the world by an instance's transform).
     pub fn at(scene: &'a Scene, world: &World, ray: &Ray, hit: &WorldHit) -> Self {
-        Self::at_over(scene, world, ray, hit, None)
+        Self::at_over(scene, &PlainMaterials::none(), world, ray, hit, None)
     }
 
     /// [`Surface::at`] with the textures read over the footprint of `cone`, the ray's cone (see
-    /// [`crate::ray_cone`]); `None` reads them at the hit point.
-    pub fn at_over(scene: &'a Scene, world: &World, ray: &Ray, hit: &WorldHit, cone: Option<RayCone>) -> Self {
+    /// [`crate::ray_cone`]); `None` reads them at the hit point. The parameters of a material
+    /// without textures are taken from `plain` when it has them.
+    pub fn at_over(
+        scene: &'a Scene,
+        plain: &PlainMaterials,
+        world: &World,
+        ray: &Ray,
+        hit: &WorldHit,
+        cone: Option<RayCone>,
+    ) -> Self {
         let object = &scene.objects[hit.object as usize];
-        let material = &scene.materials[object.material_of(hit.prim) as usize];
+        let index = object.material_of(hit.prim);
+        let material = &scene.materials[index as usize];
         let p = world.hit_point(ray, hit);
         let d = ray.dir().normalize();
         let (geometric, mut shading) = world.normals(hit, p);
@@ -58,19 +98,24 @@ impl<'a> Surface<'a> {
         let n = if entering { geometric } else { -geometric };
         // Set 1 is interpolated only for materials that read it; each set gets its own
         // footprint, since the two map the triangle onto their images differently.
-        let mut coords = TexCoords::default();
-        if !material.textures.is_empty() {
-            coords = object.tex_coords(material.textures.reads_set1(), hit.prim, hit.u, hit.v);
-            if let Some(c) = cone {
-                let width = c.width_at((p - ray.origin()).length());
-                for set in 0..2 {
-                    if coords.uv[set].is_some() {
-                        coords.footprint[set] = footprint(object, set as u32, hit.prim, d, width);
+        let params = match plain.get(index) {
+            Some(params) => params,
+            None => {
+                let mut coords = TexCoords::default();
+                if !material.textures.is_empty() {
+                    coords = object.tex_coords(material.textures.reads_set1(), hit.prim, hit.u, hit.v);
+                    if let Some(c) = cone {
+                        let width = c.width_at((p - ray.origin()).length());
+                        for set in 0..2 {
+                            if coords.uv[set].is_some() {
+                                coords.footprint[set] = footprint(object, set as u32, hit.prim, d, width);
+                            }
+                        }
                     }
                 }
+                material.evaluate_at(&scene.textures, &coords)
             }
-        }
-        let params = material.evaluate_at(&scene.textures, &coords);
+        };
         if let Some(bent) = params.normal_ts
             && let Some(tangent) = object.tangent(hit.prim, hit.u, hit.v)
         {

@@ -29,7 +29,7 @@ use englobe_scene::Scene;
 use crate::environment::EnvironmentLight;
 use crate::optics::{fresnel_dielectric, reflect, refract};
 use crate::ray_cone::RayCone;
-use crate::shading::Surface;
+use crate::shading::{PlainMaterials, Surface};
 use crate::stats::{RayKind, Tally};
 use crate::visibility::Visibility;
 
@@ -43,6 +43,7 @@ pub struct Whitted<'a> {
     vis: Visibility<'a>,
     environment: Option<EnvironmentLight>,
     cone: Option<RayCone>,
+    plain: PlainMaterials,
 }
 
 impl<'a> Whitted<'a> {
@@ -54,6 +55,7 @@ impl<'a> Whitted<'a> {
             vis: Visibility::new(scene, world),
             environment: scene.environment.as_ref().map(EnvironmentLight::new),
             cone: None,
+            plain: PlainMaterials::new(scene),
         }
     }
 
@@ -121,7 +123,7 @@ impl<'a> Whitted<'a> {
         let mut surfaces: [Option<Surface>; PACKET] = std::array::from_fn(|_| None);
         for ((slot, ray), hit) in surfaces.iter_mut().zip(rays).zip(hits) {
             if let Some(hit) = hit {
-                *slot = Some(Surface::at_over(self.scene, self.world, ray, hit, self.cone));
+                *slot = Some(Surface::at_over(self.scene, &self.plain, self.world, ray, hit, self.cone));
             }
         }
         let origins: [Vec3; PACKET] = std::array::from_fn(|i| surfaces[i].as_ref().map_or(Vec3::ZERO, |s| s.outside()));
@@ -172,7 +174,7 @@ impl<'a> Whitted<'a> {
         let Some(hit) = hit else {
             return self.environment.as_ref().map_or(self.scene.image.background, |e| e.radiance(ray.dir()));
         };
-        let s = Surface::at_over(self.scene, self.world, ray, &hit, cone);
+        let s = Surface::at_over(self.scene, &self.plain, self.world, ray, &hit, cone);
         let (lit, highlight) = s.direct_light(self.scene, &self.vis, tally);
         self.shade_lit(ray, &s, (lit, highlight), depth, weight, cone, tally)
     }

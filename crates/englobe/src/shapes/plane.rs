@@ -23,6 +23,21 @@ impl Plane {
         let n = normal.try_normalize()?;
         Some(Plane { normal: n, offset: n.dot(point) })
     }
+
+    /// The parameter at which the line of `ray` crosses the plane, whatever the ray's interval:
+    /// not finite for a ray parallel to the plane (either no point or every point of the ray
+    /// lies in it; a ray that slides along a surface does not hit it). With no branch, so that
+    /// the rays of a packet compute theirs side by side.
+    #[inline(always)]
+    pub fn parameter(&self, ray: &Ray) -> f32 {
+        (self.offset - self.normal.dot(ray.origin())) / self.normal.dot(ray.dir())
+    }
+
+    /// Whether the parameter `t` (see [`Plane::parameter`]) is a hit within `t_min..=t_max`.
+    #[inline(always)]
+    pub fn hit_within(t: f32, t_min: f32, t_max: f32) -> bool {
+        t >= t_min && t <= t_max && t.is_finite()
+    }
 }
 
 impl Bounded for Plane {
@@ -34,14 +49,8 @@ impl Bounded for Plane {
 impl Intersect for Plane {
     #[inline]
     fn intersect(&self, ray: &Ray) -> Option<PrimHit> {
-        let denom = self.normal.dot(ray.dir());
-        if denom == 0.0 {
-            // Parallel: either no point or every point of the ray lies in the plane; a ray that
-            // slides along a surface does not hit it.
-            return None;
-        }
-        let t = (self.offset - self.normal.dot(ray.origin())) / denom;
-        (t >= ray.t_min && t <= ray.t_max && t.is_finite()).then(|| PrimHit::at(t))
+        let t = self.parameter(ray);
+        Plane::hit_within(t, ray.t_min, ray.t_max).then(|| PrimHit::at(t))
     }
 
     fn normal(&self, _p: Vec3, _hit: &PrimHit) -> Vec3 {

@@ -118,14 +118,17 @@ impl World {
                 }
             }
         }
-        for (i, (h, ray)) in hits.iter_mut().zip(rays).enumerate() {
-            *h = if valid >> i & 1 == 0 {
-                None
-            } else if top.is_some() {
-                self.closest_unbounded(ray, best[i], counters, &mut NoFilter)
-            } else {
-                self.closest_beyond_meshes(ray, best[i], counters, &mut NoFilter)
-            };
+        if top.is_none() && self.accel_in_use() {
+            // Shapes or instances in a top level too deep for a packet: each ray alone.
+            for (i, (b, ray)) in best.iter_mut().zip(rays).enumerate() {
+                if valid >> i & 1 != 0 {
+                    *b = self.closest_in_accel(ray, *b, counters, &mut NoFilter);
+                }
+            }
+        }
+        self.closest_unbounded_packet(rays, valid, &mut best[..n], counters);
+        for (i, h) in hits.iter_mut().enumerate() {
+            *h = if valid >> i & 1 == 0 { None } else { best[i] };
         }
     }
 
@@ -133,9 +136,7 @@ impl World {
     /// tests them, then the meshes for the rays still unblocked, then the rest.
     fn any_packet_of<C: Counters>(&self, rays: &[Ray], mask: &mut [bool], counters: &mut C) {
         let valid = valid_mask(rays);
-        let mut blocked = (0..rays.len())
-            .filter(|&i| valid >> i & 1 != 0 && self.any_unbounded(&rays[i], counters, &mut NoFilter))
-            .fold(0u32, |m, i| m | 1 << i);
+        let mut blocked = self.any_unbounded_packet(rays, valid, counters);
         if let Some(t) = &self.triangles {
             blocked |= t.any_packet_among(rays, valid & !blocked, counters);
         }

@@ -35,6 +35,7 @@ mod bottom;
 mod motion;
 mod object;
 mod packet;
+mod planes;
 mod proximity;
 mod query;
 mod refit;

@@ -125,13 +125,27 @@ impl World {
         counters: &mut C,
         filter: &mut F,
     ) -> Option<WorldHit> {
+        best = self.closest_in_accel(ray, best, counters, filter);
+        self.closest_unbounded(ray, best, counters, filter)
+    }
+
+    /// The closest hit of a valid `ray`, given `best`, the closest on the meshes' triangle tree:
+    /// the shapes and instances (the unbounded shapes left out).
+    #[inline(always)]
+    pub(super) fn closest_in_accel<C: Counters, F: HitFilter<WorldHit>>(
+        &self,
+        ray: &Ray,
+        best: Option<WorldHit>,
+        counters: &mut C,
+        filter: &mut F,
+    ) -> Option<WorldHit> {
         if self.accel_in_use()
             && let Some(hit) = self.accel_closest_hit(ray, best.map_or(ray.t_max, |b| b.t), counters, filter)
             && beats(&hit, best.as_ref())
         {
-            best = Some(hit);
+            return Some(hit);
         }
-        self.closest_unbounded(ray, best, counters, filter)
+        best
     }
 
     /// The closest hit of a valid `ray`, given `best`, the closest on the bounded primitives: the
