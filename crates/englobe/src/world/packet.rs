@@ -56,14 +56,22 @@ impl<'a> TopPacket<'a> {
     fn new(world: &'a World, top: &'a WideBvh, rays: &[Ray]) -> Self {
         let len = rays.len();
         debug_assert!((1..=PACKET).contains(&len), "a packet holds 1 to {PACKET} rays");
-        let ray = |i: usize| rays[i.min(len - 1)];
-        TopPacket {
+        // Filled by plain copies, the last ray first in every lane: `std::array::from_fn` was
+        // not inlined here and built each record in a temporary first, one partly overlapping
+        // store and load after another.
+        let last = rays[len - 1];
+        let mut packet = TopPacket {
             world,
             top,
-            records: std::array::from_fn(|i| HitRecord::new(ray(i))),
+            records: [HitRecord::new(last); PACKET],
             instances: [ClosestInstance::default(); PACKET],
-            limits: Lanes(std::array::from_fn(|i| reach(ray(i).t_max))),
+            limits: Lanes([reach(last.t_max); PACKET]),
+        };
+        for (i, ray) in rays.iter().enumerate() {
+            packet.records[i] = HitRecord::new(*ray);
+            packet.limits.0[i] = reach(ray.t_max);
         }
+        packet
     }
 }
 
