@@ -92,44 +92,49 @@ impl World {
         self.walks_packets() && coherent(rays, &self.bounds())
     }
 
-    /// One packet of at most [`PACKET`] rays.
+    /// One packet of at most [`PACKET`] rays. Every step below answers `None` for the rays that
+    /// are not valid, and the hits are kept in `hits` from the first step to the last.
     fn closest_packet_of<C: Counters>(&self, rays: &[Ray], hits: &mut [Option<WorldHit>], counters: &mut C) {
         let n = rays.len();
         if n == 0 {
             return;
         }
         let valid = valid_mask(rays);
-        let mut meshes = [None; PACKET];
-        if let Some(t) = &self.triangles {
-            t.closest_packet_among(rays, valid, &mut meshes[..n], counters);
+        match &self.triangles {
+            Some(t) => {
+                let mut meshes = [None; PACKET];
+                t.closest_packet_among(rays, valid, &mut meshes[..n], counters);
+                for (h, m) in hits.iter_mut().zip(meshes) {
+                    *h = m.map(|m| self.mesh_hit(m));
+                }
+            }
+            None => hits.fill(None),
         }
-        let mut best: [Option<WorldHit>; PACKET] = std::array::from_fn(|i| meshes[i].map(|m| self.mesh_hit(m)));
         let top = self.packet_top();
         if let Some(top) = top {
             // The shapes and instances in a packet too, each ray up to its closest mesh hit.
-            let t_max: [f32; PACKET] = std::array::from_fn(|i| best[i].map_or(rays[i.min(n - 1)].t_max, |b| b.t));
+            let mut t_max = [0.0; PACKET];
+            for ((t, h), ray) in t_max.iter_mut().zip(hits.iter()).zip(rays) {
+                *t = h.map_or(ray.t_max, |h| h.t);
+            }
             let mut found = [None; PACKET];
             self.accel_closest_packet(top, rays, &t_max[..n], valid, &mut found[..n], counters);
-            for (b, hit) in best.iter_mut().zip(found) {
+            for (h, hit) in hits.iter_mut().zip(found) {
                 if let Some(hit) = hit
-                    && beats(&hit, b.as_ref())
+                    && beats(&hit, h.as_ref())
                 {
-                    *b = Some(hit);
+                    *h = Some(hit);
                 }
             }
-        }
-        if top.is_none() && self.accel_in_use() {
+        } else if self.accel_in_use() {
             // Shapes or instances in a top level too deep for a packet: each ray alone.
-            for (i, (b, ray)) in best.iter_mut().zip(rays).enumerate() {
+            for (i, (h, ray)) in hits.iter_mut().zip(rays).enumerate() {
                 if valid >> i & 1 != 0 {
-                    *b = self.closest_in_accel(ray, *b, counters, &mut NoFilter);
+                    *h = self.closest_in_accel(ray, *h, counters, &mut NoFilter);
                 }
             }
         }
-        self.closest_unbounded_packet(rays, valid, &mut best[..n], counters);
-        for (i, h) in hits.iter_mut().enumerate() {
-            *h = if valid >> i & 1 == 0 { None } else { best[i] };
-        }
+        self.closest_unbounded_packet(rays, valid, hits, counters);
     }
 
     /// One packet of at most [`PACKET`] rays: the unbounded shapes first, as [`World::any_hit`]
