@@ -13,9 +13,12 @@ use glam::{Vec3, Vec3A};
 /// order a structure visits them in.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Ray {
-    origin: Vec3,
-    dir: Vec3,
-    inv_dir: Vec3,
+    // Kept as aligned four-lane vectors: a ray is written by one function and read at once by
+    // the next (a camera's or a shadow ray, then its query), and whole aligned lanes let each read
+    // take its value straight from the write before it, where three-float fields straddled them.
+    origin: Vec3A,
+    dir: Vec3A,
+    inv_dir: Vec3A,
     /// Smallest parameter that counts as a hit.
     pub t_min: f32,
     /// Largest parameter that counts as a hit; structures shrink it as they find closer hits.
@@ -32,31 +35,32 @@ impl Ray {
     /// A ray over `t_min..=t_max`.
     #[inline]
     pub fn segment(origin: Vec3, dir: Vec3, t_min: f32, t_max: f32) -> Self {
-        Ray { origin, dir, inv_dir: safe_inverse(dir), t_min, t_max }
+        let dir = Vec3A::from(dir);
+        Ray { origin: origin.into(), dir, inv_dir: safe_inverse(dir), t_min, t_max }
     }
 
     /// The origin.
     #[inline(always)]
     pub fn origin(&self) -> Vec3 {
-        self.origin
+        self.origin.into()
     }
 
     /// The direction, as given (not normalised).
     #[inline(always)]
     pub fn dir(&self) -> Vec3 {
-        self.dir
+        self.dir.into()
     }
 
     /// `1 / dir` per component, with `+inf` for zero components of either sign.
     #[inline(always)]
     pub fn inv_dir(&self) -> Vec3 {
-        self.inv_dir
+        self.inv_dir.into()
     }
 
     /// The point at parameter `t`.
     #[inline(always)]
     pub fn at(&self, t: f32) -> Vec3 {
-        self.origin + self.dir * t
+        (self.origin + self.dir * t).into()
     }
 
     /// The same ray over a different interval.
@@ -72,23 +76,19 @@ impl Ray {
     #[inline]
     pub fn is_valid(&self) -> bool {
         // Every query starts here, so the six coordinates are checked with vector comparisons.
-        let (o, d) = (Vec3A::from(self.origin), Vec3A::from(self.dir));
-        (o.is_finite_mask() & d.is_finite_mask()).all()
-            && d.cmpne(Vec3A::ZERO).any()
+        (self.origin.is_finite_mask() & self.dir.is_finite_mask()).all()
+            && self.dir.cmpne(Vec3A::ZERO).any()
             && self.t_min <= self.t_max
             && self.t_min < f32::INFINITY
             && self.t_max > f32::NEG_INFINITY
     }
 }
 
-/// `1 / x`, except that both zeros map to `+inf` so that the slab test's NaN handling only ever
-/// has to deal with one sign.
-/// `1 / x` of each component, `+inf` for a zero of either sign: one vector division, as every
-/// ray pays it.
+/// `1 / x` of each component, `+inf` for a zero of either sign (so that the slab test's NaN
+/// handling only ever has to deal with one sign): one vector division, as every ray pays it.
 #[inline(always)]
-fn safe_inverse(x: Vec3) -> Vec3 {
-    let x = Vec3A::from(x);
-    Vec3A::select(x.cmpeq(Vec3A::ZERO), Vec3A::INFINITY, Vec3A::ONE / x).into()
+fn safe_inverse(x: Vec3A) -> Vec3A {
+    Vec3A::select(x.cmpeq(Vec3A::ZERO), Vec3A::INFINITY, Vec3A::ONE / x)
 }
 
 #[cfg(test)]
