@@ -51,6 +51,16 @@ impl PlainMaterials {
     }
 }
 
+/// The shadow ray from `origin` toward `light`: to just short of a point light, to infinity
+/// against a directional light's direction.
+#[inline(always)]
+pub fn shadow_ray(light: &Light, origin: Vec3) -> Ray {
+    match *light {
+        Light::Point { position, .. } => Ray::segment(origin, position - origin, 0.0, SHADOW_RAY_END),
+        Light::Directional { direction, .. } => Ray::new(origin, -direction),
+    }
+}
+
 /// A hit, ready for shading.
 pub struct Surface<'a> {
     /// The hit point (moved back onto the surface where the shape allows).
@@ -156,7 +166,20 @@ impl<'a> Surface<'a> {
     /// point moved off the surface: [`Surface::outside`]), meets something.
     #[inline]
     pub fn light_ray(&self, light: &Light, origin: Vec3) -> Option<(Vec3, Vec3, Ray)> {
-        let (to_light, radiance) = match *light {
+        let (to_light, radiance) = self.light_toward(light);
+        if !self.faces(to_light) {
+            return None; // the light is behind the surface
+        }
+        Some((to_light, radiance, shadow_ray(light, origin)))
+    }
+
+    /// The unit direction toward `light` and the radiance it sends to the point, whether or not
+    /// the light is in front of the surface ([`Surface::faces`]). The first half of
+    /// [`Surface::light_ray`], apart so that a packet's surfaces compute theirs one after the
+    /// other with no branch between them, their square roots and divisions overlapping.
+    #[inline(always)]
+    pub fn light_toward(&self, light: &Light) -> (Vec3, Vec3) {
+        match *light {
             Light::Point { position, power } => {
                 // Shading uses the true point; only the shadow ray starts off the surface.
                 let v = position - self.p;
@@ -164,15 +187,17 @@ impl<'a> Surface<'a> {
                 (v / dist2.sqrt(), power / dist2)
             }
             Light::Directional { direction, radiance } => (-direction, radiance),
-        };
-        if to_light.dot(self.n) <= 0.0 || !to_light.is_finite() {
-            return None; // the light is behind the surface
         }
-        let shadow_ray = match *light {
-            Light::Point { position, .. } => Ray::segment(origin, position - origin, 0.0, SHADOW_RAY_END),
-            Light::Directional { direction, .. } => Ray::new(origin, -direction),
-        };
-        Some((to_light, radiance, shadow_ray))
+    }
+
+    /// Whether light arriving along `to_light` (see [`Surface::light_toward`]) is in front of
+    /// the surface, on the side the ray came from.
+    #[inline(always)]
+    pub fn faces(&self, to_light: Vec3) -> bool {
+        // Not `dot > 0`: a NaN product (never for a sound surface) lets the light through, as
+        // it always has.
+        let behind = to_light.dot(self.n) <= 0.0;
+        !behind && to_light.is_finite()
     }
 
     /// Calls `f(to_light, radiance)` for every point or directional light in front of the

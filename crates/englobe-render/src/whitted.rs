@@ -29,7 +29,7 @@ use englobe_scene::Scene;
 use crate::environment::EnvironmentLight;
 use crate::optics::{fresnel_dielectric, reflect, refract};
 use crate::ray_cone::RayCone;
-use crate::shading::{PlainMaterials, Surface};
+use crate::shading::{PlainMaterials, Surface, shadow_ray};
 use crate::stats::{RayKind, Tally};
 use crate::visibility::Visibility;
 
@@ -132,10 +132,20 @@ impl<'a> Whitted<'a> {
             // The shadow rays of the surfaces in front of which this light is, side by side.
             let mut shadow = [Ray::new(Vec3::ZERO, Vec3::Z); PACKET];
             let mut arriving = [(0usize, Vec3::ZERO, Vec3::ZERO); PACKET];
+            // Every surface's direction to the light first, with no branch on it, so that their
+            // square roots and divisions overlap; then the surfaces in front of the light.
+            let mut toward = [(Vec3::ZERO, Vec3::ZERO); PACKET];
+            for (t, s) in toward.iter_mut().zip(&surfaces) {
+                if let Some(s) = s {
+                    *t = s.light_toward(source);
+                }
+            }
             let mut count = 0;
-            for (i, s) in surfaces.iter().enumerate() {
-                if let Some((to_light, radiance, ray)) = s.as_ref().and_then(|s| s.light_ray(source, origins[i])) {
-                    shadow[count] = ray;
+            for (i, (s, &(to_light, radiance))) in surfaces.iter().zip(&toward).enumerate() {
+                if let Some(s) = s
+                    && s.faces(to_light)
+                {
+                    shadow[count] = shadow_ray(source, origins[i]);
                     arriving[count] = (i, to_light, radiance);
                     count += 1;
                 }
