@@ -22,7 +22,8 @@ pub(crate) const SHADOW_RAY_END: f32 = 1.0 - 1e-4;
 
 /// The parameters of a scene's materials that have no texture, by material index: they are the
 /// same at every hit, so an integrator works them out once rather than at each (where the
-/// roughness alone costs a division and two square roots, one waiting on the other).
+/// roughness alone costs a division and two square roots, one waiting on the other). The default
+/// knows no material's: every hit evaluates its material.
 #[derive(Clone, Debug, Default)]
 pub struct PlainMaterials {
     params: Vec<Option<SurfaceParams>>,
@@ -37,11 +38,6 @@ impl PlainMaterials {
             .map(|m| m.textures.is_empty().then(|| m.evaluate_at(&scene.textures, &TexCoords::default())))
             .collect();
         PlainMaterials { params }
-    }
-
-    /// No material's: every hit evaluates its material.
-    pub fn none() -> Self {
-        PlainMaterials::default()
     }
 
     /// The parameters of material `index`, if it has no texture and is known here.
@@ -84,7 +80,7 @@ impl<'a> Surface<'a> {
     /// coordinates (each in the set it names), the shading normal bent by its normal map (in the
     /// frame of the mesh's tangents, moved into the world by an instance's transform).
     pub fn at(scene: &'a Scene, world: &World, ray: &Ray, hit: &WorldHit) -> Self {
-        Self::at_over(scene, &PlainMaterials::none(), world, ray, hit, None)
+        Self::at_over(scene, &PlainMaterials::default(), world, ray, hit, None)
     }
 
     /// [`Surface::at`] with the textures read over the footprint of `cone`, the ray's cone (see
@@ -245,5 +241,54 @@ impl<'a> Surface<'a> {
             highlight += h;
         });
         (diffuse, highlight)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use englobe::Vec2;
+    use englobe_scene::{AlphaMode, MaterialModel, TextureRef};
+
+    use super::*;
+
+    /// What the table gives is what every hit would evaluate, for every model and alpha mode,
+    /// wherever the hit; a material with a texture, or one the table does not know, is left to
+    /// each hit.
+    #[test]
+    fn plain_materials_are_what_each_hit_would_evaluate() {
+        let text = r#"
+            [image]
+            width = 8
+            height = 8
+            [camera]
+            position = [0.0, 0.0, -3.0]
+            look_at = [0.0, 0.0, 0.0]
+            fov = 40
+            [materials.clay]
+            diffuse = [0.8, 0.6, 0.5]
+            specular = [0.2, 0.2, 0.2]
+            shininess = 30
+            [[sphere]]
+            center = [0.0, 0.0, 0.0]
+            radius = 1.0
+            material = "clay"
+        "#;
+        let mut scene = englobe_scene::parse_scene(text, "clay.toml".as_ref()).unwrap();
+        let mut metal = scene.materials[0].clone();
+        metal.model = MaterialModel::MetallicRoughness { metallic: 0.3, roughness: 0.6, transmission: 0.1 };
+        metal.alpha.mode = AlphaMode::Blend;
+        metal.alpha.factor = 0.4;
+        let mut textured = scene.materials[0].clone();
+        textured.textures.base_color = Some(TextureRef::new(0));
+        scene.materials.extend([metal, textured]);
+        let plain = PlainMaterials::new(&scene);
+        let last = scene.materials.len() - 1;
+        for (i, m) in scene.materials.iter().enumerate() {
+            let at_hit = m.evaluate_at(&scene.textures, &TexCoords::one(Some(Vec2::new(0.3, 0.7)), None));
+            let expected = (i != last).then_some(at_hit);
+            assert_eq!(plain.get(i as u32), expected, "material {i}");
+        }
+        assert_eq!(plain.get(scene.materials.len() as u32), None);
+        assert_eq!(PlainMaterials::default().get(0), None);
     }
 }

@@ -417,7 +417,9 @@ mod tests {
     use super::*;
     use crate::accel::{NoCount, WorkCounts};
     use crate::shapes::TriangleMesh;
-    use crate::shapes::{Plane, Sphere, Triangle};
+    use crate::shapes::{Instance, Plane, Sphere, Triangle};
+    use glam::Affine3A;
+    use std::sync::Arc;
 
     fn sample() -> Vec<Object> {
         vec![
@@ -431,6 +433,36 @@ mod tests {
             .unwrap()
             .into(),
         ]
+    }
+
+    /// Both normals in one look-up are the two asked apart, on a shape, a flat mesh, a smooth
+    /// mesh (its normals cancelling out at one point) and their instances.
+    #[test]
+    fn both_normals_at_once_are_the_two_asked_apart() {
+        let quad = vec![Vec3::ZERO, Vec3::X, Vec3::new(1.0, 1.0, 0.0), Vec3::Y];
+        let flat = Arc::new(TriangleMesh::new(quad.clone(), vec![[0, 1, 2], [0, 2, 3]]).unwrap());
+        let normals = vec![Vec3::new(0.3, 0.0, 1.0), Vec3::new(-0.3, 0.0, -1.0), Vec3::Z, Vec3::new(0.0, 0.5, 1.0)];
+        let smooth =
+            Arc::new(TriangleMesh::new(quad, vec![[0, 1, 2], [0, 2, 3]]).unwrap().with_normals(normals).unwrap());
+        let turn = Affine3A::from_scale_rotation_translation(
+            Vec3::new(1.0, -2.0, 0.5),
+            glam::Quat::from_rotation_y(0.7),
+            Vec3::X,
+        );
+        let mut objects = sample();
+        objects.push(Object::Mesh(flat.clone()));
+        objects.push(Object::Mesh(smooth.clone()));
+        objects.push(Instance::new(flat, turn).unwrap().into());
+        objects.push(Instance::new(smooth, turn).unwrap().into());
+        let world = World::build(objects, AccelKind::BvhWide).unwrap();
+        let p = Vec3::new(0.2, 0.3, 0.0);
+        for object in 0..world.objects().len() as u32 {
+            for (prim, u, v) in [(0, 0.2, 0.3), (1, 0.5, 0.5), (0, 0.5, 0.0)] {
+                let hit = WorldHit { t: 1.0, object, prim: if object < 4 { 0 } else { prim }, u, v };
+                let apart = (world.geometric_normal(&hit, p), world.shading_normal(&hit, p));
+                assert_eq!(world.normals(&hit, p), apart, "object {object}, {hit:?}");
+            }
+        }
     }
 
     #[test]

@@ -1,7 +1,7 @@
 //! The two queries of a [`World`], closest hit and any hit, over its structures in turn: on the
 //! fast path the plain meshes' triangles first (their closest hit bounds what follows), then the
 //! structure over the other bounded primitives, whose closure tests shapes exactly and sends
-//! instances down to their bottom level, then the unbounded shapes.
+//! instances down to their bottom level, then the unbounded shapes (`planes.rs`).
 //!
 //! Each step keeps the closest hit under one rule: closer, or as close on a lower object, or on
 //! the same object a lower primitive. Primitives are numbered object after object, so that is the
@@ -148,34 +148,6 @@ impl World {
         best
     }
 
-    /// The closest hit of a valid `ray`, given `best`, the closest on the bounded primitives: the
-    /// unbounded shapes.
-    #[inline(always)]
-    pub(super) fn closest_unbounded<C: Counters, F: HitFilter<WorldHit>>(
-        &self,
-        ray: &Ray,
-        mut best: Option<WorldHit>,
-        counters: &mut C,
-        filter: &mut F,
-    ) -> Option<WorldHit> {
-        if self.unbounded.is_empty() {
-            return best;
-        }
-        let mut bounded = ray.with_range(ray.t_min, best.map_or(ray.t_max, |b| b.t));
-        for (object, plane) in &self.unbounded {
-            counters.exact_test();
-            if let Some(h) = plane.intersect(&bounded) {
-                let object = *object;
-                let hit = WorldHit { t: h.t, object, prim: 0, u: h.u, v: h.v };
-                if beats(&hit, best.as_ref()) && (F::ACCEPTS_ALL || filter.accept(&hit)) {
-                    bounded.t_max = h.t;
-                    best = Some(hit);
-                }
-            }
-        }
-        best
-    }
-
     /// The closest hit among the primitives of [`World::accel`] (shapes, instances, and on the
     /// teaching structures the meshes' triangles) before `t_max`.
     fn accel_closest_hit<C: Counters, F: HitFilter<WorldHit>>(
@@ -266,22 +238,6 @@ impl World {
                 .as_ref()
                 .is_some_and(|t| t.any_hit_of_valid(ray, counters, Located { world: self, filter: &mut filter }))
             || self.any_in_accel(ray, counters, &mut filter)
-    }
-
-    /// Whether a valid `ray` hits one of the unbounded shapes (planes).
-    #[inline]
-    pub(super) fn any_unbounded<C: Counters, F: HitFilter<WorldHit>>(
-        &self,
-        ray: &Ray,
-        counters: &mut C,
-        filter: &mut F,
-    ) -> bool {
-        self.unbounded.iter().any(|&(object, plane)| {
-            counters.exact_test();
-            plane
-                .intersect(ray)
-                .is_some_and(|h| F::ACCEPTS_ALL || filter.accept(&WorldHit { t: h.t, object, prim: 0, u: h.u, v: h.v }))
-        })
     }
 
     /// Whether a valid `ray` hits one of the primitives of [`World::accel`] (shapes, instances).
