@@ -69,9 +69,9 @@ const EMPTY_BIN: Bin = Bin { min: Vec3A::INFINITY, max: Vec3A::NEG_INFINITY, cou
 
 impl Bin {
     #[inline(always)]
-    fn add(&mut self, b: &Aabb) {
-        self.min = self.min.min(Vec3A::from(b.min));
-        self.max = self.max.max(Vec3A::from(b.max));
+    fn add(&mut self, min: Vec3A, max: Vec3A) {
+        self.min = self.min.min(min);
+        self.max = self.max.max(max);
         self.count += 1;
     }
 
@@ -97,6 +97,24 @@ impl Bin {
 #[inline(always)]
 fn bin_of(c: f32, min: f32, scale: f32, bins: usize) -> usize {
     (((c - min) * scale) as usize).min(bins - 1)
+}
+
+/// [`bin_of`] on the three coordinates of `c` at once, `last` being `bins - 1` in each lane: the
+/// same products, then the same saturation (a NaN goes to the first bin, as the integer
+/// conversion sends it: x86's `max` returns its second operand, zero, for a NaN, and elsewhere
+/// the saturating conversion below maps a NaN that went through to zero).
+#[inline(always)]
+fn bin_vector(c: Vec3A, min: Vec3A, scale: Vec3A, last: Vec3A) -> [u32; 3] {
+    let clamped = ((c - min) * scale).max(Vec3A::ZERO).min(last);
+    // In range already: a plain truncation, without the saturating conversion's branches.
+    #[cfg(target_arch = "x86_64")]
+    {
+        // SAFETY: SSE2 is part of x86-64's baseline; any 128 bits are four valid `u32`s.
+        let i: [u32; 4] = unsafe { std::mem::transmute(std::arch::x86_64::_mm_cvttps_epi32(clamped.into())) };
+        [i[0], i[1], i[2]]
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    clamped.as_uvec3().to_array()
 }
 
 impl Splitter for BinnedSah {
@@ -128,11 +146,15 @@ impl Splitter for BinnedSah {
         }
         let min = centroid_bounds.min;
         let mut bins = [[EMPTY_BIN; MAX_BINS]; 3];
+        // All three axes' bins at once, each coordinate as `bin_of` places it (an axis that
+        // cannot be split fills its first bin, which no plane reads).
+        let (c_min, c_scale) = (Vec3A::from(min), Vec3A::from_array(scale));
+        let last = Vec3A::splat((k - 1) as f32);
         for r in refs.iter() {
-            for axis in 0..3 {
-                if scale[axis] > 0.0 {
-                    bins[axis][bin_of(r.centroid[axis], min[axis], scale[axis], k)].add(&r.bounds);
-                }
+            let (lo, hi) = (r.min(), r.max());
+            let slot = bin_vector(r.centroid(), c_min, c_scale, last);
+            for (axis, bins) in bins.iter_mut().enumerate() {
+                bins[(slot[axis] as usize).min(MAX_BINS - 1)].add(lo, hi);
             }
         }
 
@@ -164,7 +186,7 @@ impl Splitter for BinnedSah {
             return None;
         }
         let (lo, s) = (min[axis], scale[axis]);
-        Some(partition(refs, |r| bin_of(r.centroid[axis], lo, s, k) < plane))
+        Some(partition(refs, |r| bin_of(r.centroid_on(axis), lo, s, k) < plane))
     }
 }
 
@@ -230,6 +252,16 @@ mod tests {
         assert_eq!(bin_of(f32::NAN, 0.0, 1.0, 8), 0);
         assert_eq!(bin_of(f32::INFINITY, 0.0, 1.0, 8), 7);
         assert_eq!(bin_of(-1.0, 0.0, 1.0, 8), 0);
+        // The three-lane placement is the one-lane one, whatever the value.
+        let odd = [f32::NAN, f32::INFINITY, f32::NEG_INFINITY, -1.0, -0.0, 0.0, 0.99, 1.0, 6.5, 7.0, 7.99, 8.0, 1e30];
+        for (i, &x) in odd.iter().enumerate() {
+            let (y, z) = (odd[(i + 3) % odd.len()], odd[(i + 7) % odd.len()]);
+            let (min, scale) = (Vec3A::new(0.0, 0.5, -2.0), Vec3A::new(1.0, 2.0, 0.25));
+            let got = bin_vector(Vec3A::new(x, y, z), min, scale, Vec3A::splat(7.0));
+            let expected =
+                [x, y, z].iter().enumerate().map(|(a, &c)| bin_of(c, min[a], scale[a], 8) as u32).collect::<Vec<_>>();
+            assert_eq!(got.to_vec(), expected, "{x} {y} {z}");
+        }
     }
 
     #[test]

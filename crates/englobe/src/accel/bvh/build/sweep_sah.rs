@@ -47,8 +47,8 @@ impl SweepSah {
 
 /// Sorts by centroid along `axis`, the index breaking ties, so the order is deterministic.
 fn sort_along(refs: &mut [PrimRef], axis: usize) {
-    refs.sort_unstable_by(|a, b| match a.centroid[axis].total_cmp(&b.centroid[axis]) {
-        Ordering::Equal => a.index.cmp(&b.index),
+    refs.sort_unstable_by(|a, b| match a.centroid()[axis].total_cmp(&b.centroid()[axis]) {
+        Ordering::Equal => a.index().cmp(&b.index()),
         other => other,
     });
 }
@@ -83,12 +83,12 @@ impl Splitter for SweepSah {
             right.resize(n, 0.0);
             let mut suffix = Aabb::EMPTY;
             for i in (1..n).rev() {
-                suffix = suffix.union(&refs[i].bounds);
+                suffix = suffix.union(&refs[i].bounds());
                 right[i] = suffix.surface_area() * (n - i) as f32;
             }
             let mut prefix = Aabb::EMPTY;
             for i in 1..n {
-                prefix = prefix.union(&refs[i - 1].bounds);
+                prefix = prefix.union(&refs[i - 1].bounds());
                 let cost = prefix.surface_area() * i as f32 + right[i];
                 if best.is_none_or(|(c, _, _)| cost < c) {
                     best = Some((cost, axis, i));

@@ -20,23 +20,76 @@
 //! tree comes out in depth-first order; slots left over (where a leaf holds several primitives)
 //! are never reached from the root and are dropped by the layout.
 
-use glam::Vec3;
+use glam::{Vec3A, Vec4};
 
 use super::parallel;
 use crate::Aabb;
 use crate::accel::bvh::layout::{BuildKind, BuildNode, BuildTree};
 use crate::accel::bvh::stats::{SAH_INTERSECTION_COST, SAH_TRAVERSAL_COST};
 
-/// A primitive as the top-down builders move it around: its box, its box's centre and its index.
-/// Builders reorder these in place; the final order becomes the leaves' primitive references.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// A primitive as the top-down builders move it around: its box and its index, in two aligned
+/// four-float vectors (32 bytes, Embree's `PrimRef` layout: the index rides in the fourth lane of
+/// the lower corner), so that the builders' passes over millions of them read half a cache line
+/// each and bin them with vector operations. Builders reorder these in place; the final order
+/// becomes the leaves' primitive references.
+#[derive(Clone, Copy, Debug)]
+#[repr(C)]
 pub struct PrimRef {
+    /// The box's lower corner; the fourth lane holds the index's bits, bit 30 flipped (see
+    /// [`INDEX_BITS`]).
+    lo: Vec4,
+    /// The box's upper corner (fourth lane unused).
+    hi: Vec4,
+}
+
+/// Flipped in the index's bits before they are stored as a float: the vector operations on a
+/// reference's corners also run on the fourth lane, and a small index's bits as they are would
+/// be a subnormal number, which x86 processors add and multiply in slow microcode (about a
+/// hundred cycles). Flipped, every index below 2^30 is a normal number, an infinity or a NaN.
+const INDEX_BITS: u32 = 1 << 30;
+
+impl PrimRef {
+    /// The reference of primitive `index`, whose box is `bounds`.
+    #[inline]
+    pub fn new(bounds: &Aabb, index: u32) -> Self {
+        PrimRef { lo: bounds.min.extend(f32::from_bits(index ^ INDEX_BITS)), hi: bounds.max.extend(1.0) }
+    }
+
+    /// The box's lower corner.
+    #[inline(always)]
+    pub fn min(&self) -> Vec3A {
+        Vec3A::from_vec4(self.lo)
+    }
+
+    /// The box's upper corner.
+    #[inline(always)]
+    pub fn max(&self) -> Vec3A {
+        Vec3A::from_vec4(self.hi)
+    }
+
     /// The primitive's box.
-    pub bounds: Aabb,
-    /// The box's centre.
-    pub centroid: Vec3,
+    #[inline(always)]
+    pub fn bounds(&self) -> Aabb {
+        Aabb::new(self.min().into(), self.max().into())
+    }
+
+    /// The box's centre, computed as [`Aabb::center`] computes it.
+    #[inline(always)]
+    pub fn centroid(&self) -> Vec3A {
+        (self.min() + self.max()) * 0.5
+    }
+
+    /// Coordinate `axis` of the box's centre (as [`PrimRef::centroid`], one axis).
+    #[inline(always)]
+    pub fn centroid_on(&self, axis: usize) -> f32 {
+        (self.lo[axis] + self.hi[axis]) * 0.5
+    }
+
     /// The primitive's index.
-    pub index: u32,
+    #[inline(always)]
+    pub fn index(&self) -> u32 {
+        self.lo.w.to_bits() ^ INDEX_BITS
+    }
 }
 
 /// Chooses how to split a node (see [`build_tree`]).
@@ -75,23 +128,26 @@ pub fn build_tree<S: Splitter>(splitter: &S, boxes: &[Aabb]) -> BuildTree {
     if n == 0 {
         return BuildTree::default();
     }
-    let mut refs = vec![PrimRef { bounds: Aabb::EMPTY, centroid: Vec3::ZERO, index: 0 }; n];
-    parallel::fill_indexed(&mut refs, 1 << 14, |i| PrimRef {
-        bounds: boxes[i],
-        centroid: boxes[i].center(),
-        index: i as u32,
-    });
+    let mut refs = vec![PrimRef::new(&Aabb::EMPTY, 0); n];
+    parallel::fill_indexed(&mut refs, 1 << 14, |i| PrimRef::new(&boxes[i], i as u32));
     let unused = BuildNode { bounds: Aabb::EMPTY, kind: BuildKind::Leaf { first: 0, count: 0 } };
     let mut nodes = vec![unused; 2 * n - 1];
     build_parallel(splitter, &mut nodes, 0, &mut refs, 0, 0);
     let mut prims = vec![0u32; n];
-    parallel::fill_indexed(&mut prims, 1 << 14, |i| refs[i].index);
+    parallel::fill_indexed(&mut prims, 1 << 14, |i| refs[i].index());
     BuildTree { nodes, prims, root: 0 }
 }
 
 /// The union of the references' boxes and the box around their centroids.
 pub fn range_bounds(refs: &[PrimRef]) -> (Aabb, Aabb) {
-    refs.iter().fold((Aabb::EMPTY, Aabb::EMPTY), |(b, c), r| (b.union(&r.bounds), c.grown(r.centroid)))
+    let (mut lo, mut hi) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
+    let (mut c_lo, mut c_hi) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
+    for r in refs {
+        let c = r.centroid();
+        (lo, hi) = (lo.min(r.min()), hi.max(r.max()));
+        (c_lo, c_hi) = (c_lo.min(c), c_hi.max(c));
+    }
+    (Aabb::new(lo.into(), hi.into()), Aabb::new(c_lo.into(), c_hi.into()))
 }
 
 /// Where to split `refs`: `Some(mid)` with `0 < mid < len`, or `None` for a leaf.
@@ -211,6 +267,8 @@ pub fn partition(refs: &mut [PrimRef], mut left: impl FnMut(&PrimRef) -> bool) -
 
 #[cfg(test)]
 mod tests {
+    use glam::Vec3;
+
     use super::*;
     use crate::accel::bvh::validate::validate_bvh;
 
@@ -267,14 +325,24 @@ mod tests {
     }
 
     #[test]
+    fn a_reference_keeps_its_box_and_any_index() {
+        let b = Aabb::new(Vec3::new(-1.5, 0.0, 2.0), Vec3::new(-0.5, 3.0, 2.0));
+        // Indices whose bits are infinities and NaNs of every kind come back unchanged.
+        for index in [0, 1, 12_345, 0x7f80_0000, 0x7f80_0001, 0x7fc0_0000, 0xffc0_0001, u32::MAX] {
+            let r = PrimRef::new(&b, index);
+            assert_eq!((r.index(), r.bounds()), (index, b));
+            assert_eq!(Vec3::from(r.centroid()), b.center());
+        }
+    }
+
+    #[test]
     fn partition_puts_the_chosen_first() {
         let b = boxes(11);
-        let mut refs: Vec<PrimRef> =
-            b.iter().enumerate().map(|(i, b)| PrimRef { bounds: *b, centroid: b.center(), index: i as u32 }).collect();
-        let mid = partition(&mut refs, |r| r.index % 3 == 0);
+        let mut refs: Vec<PrimRef> = b.iter().enumerate().map(|(i, b)| PrimRef::new(b, i as u32)).collect();
+        let mid = partition(&mut refs, |r| r.index() % 3 == 0);
         assert_eq!(mid, 4);
-        assert!(refs[..mid].iter().all(|r| r.index % 3 == 0));
-        assert!(refs[mid..].iter().all(|r| r.index % 3 != 0));
+        assert!(refs[..mid].iter().all(|r| r.index() % 3 == 0));
+        assert!(refs[mid..].iter().all(|r| r.index() % 3 != 0));
         assert_eq!(partition(&mut refs, |_| true), 11);
         assert_eq!(partition(&mut refs, |_| false), 0);
         assert_eq!(partition(&mut [], |_| true), 0);
