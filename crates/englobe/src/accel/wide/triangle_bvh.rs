@@ -88,18 +88,18 @@ pub(super) fn triangle_of<'a>(
     move |i| triangles[i as usize].map(|v| Vec3::from_array(vertices[v as usize]))
 }
 
-/// Packs leaves into blocks of four triangles.
-struct Blocks<'a, F> {
-    triangle: F,
+/// Packs leaves into blocks of four triangles: names each block's triangles as the conversion
+/// meets its leaves; the blocks themselves are filled afterwards, in parallel ([`Blocks::fill`]).
+struct Blocks<'a> {
     /// The triangle of each of the build's boxes (several boxes name one cut triangle).
     ids: &'a [u32],
-    blocks: Vec<TriBlock>,
+    /// Each block's triangles, [`UNUSED`] in the lanes beyond them.
+    blocks: Vec<[u32; LANES]>,
     /// The leaf's triangles, each once.
     leaf_ids: Vec<u32>,
-    scratch: Vec<(u32, [Vec3; 3])>,
 }
 
-impl<F: Fn(u32) -> [Vec3; 3]> LeafSink for Blocks<'_, F> {
+impl LeafSink for Blocks<'_> {
     fn max_prims(&self) -> usize {
         4 * LANES
     }
@@ -112,11 +112,30 @@ impl<F: Fn(u32) -> [Vec3; 3]> LeafSink for Blocks<'_, F> {
         self.leaf_ids.sort_unstable();
         self.leaf_ids.dedup();
         for chunk in self.leaf_ids.chunks(LANES) {
-            self.scratch.clear();
-            self.scratch.extend(chunk.iter().map(|&id| (id, (self.triangle)(id))));
-            self.blocks.push(TriBlock::new(&self.scratch));
+            let mut block = [UNUSED; LANES];
+            block[..chunk.len()].copy_from_slice(chunk);
+            self.blocks.push(block);
         }
         (first, (self.blocks.len() as u32 - first) as u8)
+    }
+}
+
+impl Blocks<'_> {
+    /// The blocks, their vertices fetched from `triangle` on every core: the fetches follow the
+    /// leaves' order, not the mesh's, so they mostly miss the caches, and they were the largest
+    /// sequential part of a build.
+    fn fill(&self, triangle: impl Fn(u32) -> [Vec3; 3] + Sync) -> Vec<TriBlock> {
+        let mut blocks = vec![TriBlock { v: [[0.0; LANES]; 9], ids: [UNUSED; LANES] }; self.blocks.len()];
+        fill_indexed(&mut blocks, 1 << 12, |i| {
+            let ids = &self.blocks[i];
+            let used = ids.iter().take_while(|&&id| id != UNUSED).count();
+            let mut triangles = [(UNUSED, [Vec3::ZERO; 3]); LANES];
+            for (slot, &id) in triangles.iter_mut().zip(&ids[..used]) {
+                *slot = (id, triangle(id));
+            }
+            TriBlock::new(&triangles[..used])
+        });
+        blocks
     }
 }
 
@@ -171,12 +190,11 @@ impl TriangleBvh {
         let fragments = presplit(&kept, |i| triangle(ids[i as usize]), budget);
         let bvh = options.builder.build(&fragments.boxes);
         let owners: Vec<u32> = fragments.owner.iter().map(|&k| ids[k as usize]).collect();
-        let mut sink =
-            Blocks { triangle: &triangle, ids: &owners, blocks: Vec::new(), leaf_ids: Vec::new(), scratch: Vec::new() };
+        let mut sink = Blocks { ids: &owners, blocks: Vec::new(), leaf_ids: Vec::new() };
         let layout = convert(&bvh, ConvertOptions { collapse: options.collapse }, &mut sink);
         let mut built = TriangleBvh {
             nodes: layout.nodes,
-            blocks: sink.blocks,
+            blocks: sink.fill(&triangle),
             depth: layout.depth,
             bounds: bvh.bounds(),
             stored: ids.len(),
