@@ -67,6 +67,17 @@ struct Bin {
 
 const EMPTY_BIN: Bin = Bin { min: Vec3A::INFINITY, max: Vec3A::NEG_INFINITY, count: 0 };
 
+/// The bins of the three axes, kept by each thread from node to node: a node clears only the
+/// bins it uses (8 of the 32 in small nodes) instead of copying a fresh 4.5 KiB array.
+#[derive(Clone, Debug)]
+pub struct Bins([[Bin; MAX_BINS]; 3]);
+
+impl Default for Bins {
+    fn default() -> Self {
+        Bins([[EMPTY_BIN; MAX_BINS]; 3])
+    }
+}
+
 impl Bin {
     #[inline(always)]
     fn add(&mut self, min: Vec3A, max: Vec3A) {
@@ -118,7 +129,7 @@ fn bin_vector(c: Vec3A, min: Vec3A, scale: Vec3A, last: Vec3A) -> [u32; 3] {
 }
 
 impl Splitter for BinnedSah {
-    type Scratch = ();
+    type Scratch = Bins;
 
     fn max_leaf(&self) -> usize {
         self.max_leaf
@@ -130,7 +141,7 @@ impl Splitter for BinnedSah {
         bounds: &Aabb,
         centroid_bounds: &Aabb,
         must_split: bool,
-        _: &mut (),
+        scratch: &mut Bins,
     ) -> Option<usize> {
         // A node over few primitives gets about as many bins as it has primitives (at least
         // eight): more would mostly sweep empty bins, and the sweep is the cost of small nodes.
@@ -145,7 +156,10 @@ impl Splitter for BinnedSah {
             return None;
         }
         let min = centroid_bounds.min;
-        let mut bins = [[EMPTY_BIN; MAX_BINS]; 3];
+        let bins = &mut scratch.0;
+        for axis in bins.iter_mut() {
+            axis[..k].fill(EMPTY_BIN);
+        }
         // All three axes' bins at once, each coordinate as `bin_of` places it (an axis that
         // cannot be split fills its first bin, which no plane reads).
         let (c_min, c_scale) = (Vec3A::from(min), Vec3A::from_array(scale));
