@@ -113,20 +113,47 @@ pub fn time_query(
     })
 }
 
-/// Runs `build` once untimed (a warm-up: thread pools started, pages mapped), then `reps` times
-/// timed, on `pool`; returns the last result with the median time in milliseconds. Each build but
-/// the last is dropped before the next starts.
+/// What [`time_build`] measured.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BuildCost {
+    /// Median time of the timed builds, in milliseconds.
+    pub ms: f64,
+    /// How much the process's resident memory grew across the first build, the built structure
+    /// alive at the end, in bytes (`None` where the system does not say): what the structure
+    /// and whatever the build left mapped cost in memory, measured the same way for every
+    /// library.
+    pub resident_bytes: Option<u64>,
+}
+
+/// The process's resident memory in bytes, from Linux's `/proc/self/status` (`None` elsewhere).
+pub fn resident_bytes() -> Option<u64> {
+    parse_resident(&std::fs::read_to_string("/proc/self/status").ok()?)
+}
+
+/// The `VmRSS` line of a `/proc/<pid>/status` text, in bytes.
+fn parse_resident(status: &str) -> Option<u64> {
+    let line = status.lines().find(|l| l.starts_with("VmRSS:"))?;
+    let mut words = line["VmRSS:".len()..].split_whitespace();
+    let kib: u64 = words.next()?.parse().ok()?;
+    (words.next() == Some("kB")).then_some(kib * 1024)
+}
+
+/// Runs `build` once untimed (a warm-up: thread pools started, pages mapped; the growth of the
+/// resident memory across it is measured), then `reps` times timed, on `pool`; returns the last
+/// result with the median time. Each build but the last is dropped before the next starts.
 pub fn time_build<T>(
     pool: &rayon::ThreadPool,
     reps: usize,
     mut build: impl FnMut() -> anyhow::Result<T> + Send,
-) -> anyhow::Result<(T, f64)>
+) -> anyhow::Result<(T, BuildCost)>
 where
     T: Send,
 {
     pool.install(|| {
         let mut times = Vec::with_capacity(reps.max(1));
+        let before = resident_bytes();
         let mut last = Some(build()?);
+        let resident = resident_bytes().zip(before).map(|(after, before)| after.saturating_sub(before));
         for _ in 0..reps.max(1) {
             drop(last.take());
             let start = Instant::now();
@@ -134,13 +161,25 @@ where
             times.push(start.elapsed().as_secs_f64() * 1e3);
             last = Some(built);
         }
-        Ok((last.expect("at least one build"), median(&times)))
+        Ok((last.expect("at least one build"), BuildCost { ms: median(&times), resident_bytes: resident }))
     })
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn resident_memory_is_read_in_bytes() {
+        let status = "Name:\tx\nVmPeak:\t  10 kB\nVmRSS:\t    2048 kB\nThreads:\t1\n";
+        assert_eq!(parse_resident(status), Some(2048 * 1024));
+        assert_eq!(parse_resident("VmRSS: 12 MB\n"), None);
+        assert_eq!(parse_resident("Name: x\n"), None);
+        // On Linux the process has some; elsewhere nothing is claimed.
+        if cfg!(target_os = "linux") {
+            assert!(resident_bytes().is_some_and(|b| b > 0));
+        }
+    }
 
     #[test]
     fn medians() {

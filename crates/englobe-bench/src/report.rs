@@ -65,7 +65,7 @@ pub fn table(group: &[Measurement], cells: &[Cell]) -> String {
         if first.threads == 1 { "" } else { "s" },
         first.reps
     );
-    let _ = write!(s, "{:<18}{:>10}", "library", "build ms");
+    let _ = write!(s, "{:<18}{:>10}{:>8}", "library", "build ms", "B/tri");
     for c in cells {
         let _ = write!(s, "{:>18}", c.name());
     }
@@ -74,7 +74,8 @@ pub fn table(group: &[Measurement], cells: &[Cell]) -> String {
     libraries.dedup();
     for lib in libraries {
         let rows: Vec<&Measurement> = group.iter().filter(|m| m.library == lib).collect();
-        let _ = write!(s, "{:<18}{:>10.1}", lib.name(), rows[0].build_ms);
+        let bytes = rows[0].build_bytes_per_triangle().map_or("-".to_owned(), |b| format!("{b:.0}"));
+        let _ = write!(s, "{:<18}{:>10.1}{bytes:>8}", lib.name(), rows[0].build_ms);
         for c in cells {
             let cell = match rows.iter().find(|m| m.rays == c.rays && m.query == c.query) {
                 Some(m) => {

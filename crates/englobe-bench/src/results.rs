@@ -37,6 +37,9 @@ pub struct Measurement {
     pub seconds: f64,
     /// Median build time of the library on this scene and thread count, in milliseconds.
     pub build_ms: f64,
+    /// Growth of the process's resident memory across the library's first build on this scene
+    /// and thread count, in bytes (see [`crate::measure::BuildCost`]).
+    pub build_resident_bytes: Option<u64>,
     /// Rays compared with brute force (0 when checks were off).
     pub checked: usize,
     /// Of those, how many disagreed.
@@ -53,6 +56,11 @@ impl Measurement {
     /// Millions of rays per second.
     pub fn mrays_per_s(&self) -> f64 {
         self.ray_count as f64 / self.seconds / 1e6
+    }
+
+    /// Bytes of resident memory per triangle the build added, if measured.
+    pub fn build_bytes_per_triangle(&self) -> Option<f64> {
+        self.build_resident_bytes.map(|b| b as f64 / self.triangles.max(1) as f64)
     }
 
     /// Millions of triangles built per second.
@@ -101,6 +109,7 @@ pub const CSV_COLUMNS: &[&str] = &[
     "ratio_to_embree",
     "ratio_to_obvhs",
     "build_mtris_per_s",
+    "build_bytes_per_triangle",
     "triangles",
     "ray_count",
     "reps",
@@ -135,6 +144,7 @@ pub fn to_csv(all: &[Measurement]) -> String {
             optional(m.ratio_to_embree, 4),
             optional(m.ratio_to_obvhs, 4),
             format!("{:.4}", m.build_mtris_per_s()),
+            optional(m.build_bytes_per_triangle(), 1),
             m.triangles.to_string(),
             m.ray_count.to_string(),
             m.reps.to_string(),
@@ -186,6 +196,7 @@ mod tests {
             reps: 5,
             seconds,
             build_ms: 2.0,
+            build_resident_bytes: Some(64_000),
             checked: 10,
             mismatches: 0,
             ratio_to_embree: None,

@@ -91,7 +91,7 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<ExitCode> {
             for &kind in &libraries {
                 progress(format!("{}: {kind} on {threads} thread(s): building", scene.name));
                 let build_reps = args.build_reps.unwrap_or(args.reps);
-                let (library, build_ms) =
+                let (library, build) =
                     measure::time_build(&pool, build_reps, || build_library(kind, &scene, &settings))?;
                 for &cell in &cells {
                     progress(format!("{}: {kind} on {threads} thread(s): {}", scene.name, cell.name()));
@@ -108,7 +108,13 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<ExitCode> {
                             mismatches.distance
                         ));
                     }
-                    all.push(Measurement { library: kind, threads, build_ms, ..m });
+                    all.push(Measurement {
+                        library: kind,
+                        threads,
+                        build_ms: build.ms,
+                        build_resident_bytes: build.resident_bytes,
+                        ..m
+                    });
                     results::fill_ratios(&mut all);
                     results::write_atomically(&args.csv, &results::to_csv(&all))?;
                 }
@@ -207,6 +213,7 @@ fn measure_cell(
         reps: args.reps,
         seconds: timing.median(),
         build_ms: 0.0,
+        build_resident_bytes: None,
         checked: mismatches.checked,
         mismatches: mismatches.total(),
         ratio_to_embree: None,
