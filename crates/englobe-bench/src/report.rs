@@ -93,7 +93,7 @@ pub fn table(group: &[Measurement], cells: &[Cell]) -> String {
     }
     for lib in group.iter().map(|m| m.library).collect::<std::collections::BTreeSet<_>>() {
         if let Some(m) = group.iter().find(|m| m.library == lib) {
-            let _ = writeln!(s, "  {:<16}{}", lib.name(), m.structure);
+            let _ = writeln!(s, "  {:<16} {}", lib.name(), m.structure);
         }
     }
     s
