@@ -116,12 +116,19 @@ pub fn convert(bvh: &Bvh, options: ConvertOptions, sink: &mut impl LeafSink) -> 
 
     let mut nodes = vec![WideNode::EMPTY_NODE];
     let mut depth = 1;
-    let mut prims = Vec::new();
+    // Working lists kept from node to node (a build converts tens of thousands of nodes).
+    let (mut prims, mut pending) = (Vec::new(), Vec::new());
+    let mut slots: Vec<Part> = Vec::with_capacity(WIDTH);
     // (wide node to fill, the part it stands for, its level from 1)
     let mut stack: Vec<(usize, Part, u32)> = vec![(0, Part::Node(0), 1)];
     while let Some((here, part, level)) = stack.pop() {
         depth = depth.max(level);
-        let mut slots: Vec<Part> = if terminal(&part) { vec![part] } else { open(&part).to_vec() };
+        slots.clear();
+        if terminal(&part) {
+            slots.push(part);
+        } else {
+            slots.extend(open(&part));
+        }
         while slots.len() < WIDTH {
             // Of equal boxes (pieces of one large leaf), the one with the most primitives: halving
             // the largest keeps the pieces balanced instead of peeling them off one by one.
@@ -144,7 +151,7 @@ pub fn convert(bvh: &Bvh, options: ConvertOptions, sink: &mut impl LeafSink) -> 
             let bounds = bounds_of(p);
             if terminal(p) {
                 prims.clear();
-                gather(bvh, p, &mut prims);
+                gather(bvh, p, &mut prims, &mut pending);
                 let (first, items) = sink.leaf(&prims);
                 node.set_child(slot, &bounds, LEAF | first, items);
             } else {
@@ -159,14 +166,16 @@ pub fn convert(bvh: &Bvh, options: ConvertOptions, sink: &mut impl LeafSink) -> 
     WideLayout { nodes, depth }
 }
 
-/// Appends the primitives under `part` to `out`, in the binary tree's leaf order.
-fn gather(bvh: &Bvh, part: &Part, out: &mut Vec<u32>) {
+/// Appends the primitives under `part` to `out`, in the binary tree's leaf order (`stack` is
+/// working memory).
+fn gather(bvh: &Bvh, part: &Part, out: &mut Vec<u32>, stack: &mut Vec<u32>) {
     match *part {
         Part::Range { start, len, .. } => {
             out.extend_from_slice(&bvh.prim_indices()[start as usize..(start + len) as usize])
         }
         Part::Node(i) => {
-            let mut stack = vec![i];
+            stack.clear();
+            stack.push(i);
             while let Some(i) = stack.pop() {
                 let n = &bvh.nodes()[i as usize];
                 if n.is_leaf() {
