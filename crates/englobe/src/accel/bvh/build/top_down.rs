@@ -327,8 +327,10 @@ mod tests {
     #[test]
     fn a_reference_keeps_its_box_and_any_index() {
         let b = Aabb::new(Vec3::new(-1.5, 0.0, 2.0), Vec3::new(-0.5, 3.0, 2.0));
-        // Indices whose bits are infinities and NaNs of every kind come back unchanged.
-        for index in [0, 1, 12_345, 0x7f80_0000, 0x7f80_0001, 0x7fc0_0000, 0xffc0_0001, u32::MAX] {
+        // Whatever float an index is stored as (normal, subnormal, an infinity, a quiet or a
+        // signalling NaN), it comes back unchanged.
+        let stored_as = [0x3f80_0000, 0x3f80_0001, 0x3fc0_0000, 0xbfc0_0001, 0x4000_0001, 0x4000_0000];
+        for index in [0, 1, 12_345, 0x7fff_ffff, u32::MAX].into_iter().chain(stored_as) {
             let r = PrimRef::new(&b, index);
             assert_eq!((r.index(), r.bounds()), (index, b));
             assert_eq!(Vec3::from(r.centroid()), b.center());
