@@ -168,6 +168,7 @@ impl Splitter for BinnedSah {
             let (lo, hi) = (r.min(), r.max());
             let slot = bin_vector(r.centroid(), c_min, c_scale, last);
             for (axis, bins) in bins.iter_mut().enumerate() {
+                // `slot` is below `k` already; the `min` only spares the bounds check.
                 bins[(slot[axis] as usize).min(MAX_BINS - 1)].add(lo, hi);
             }
         }
@@ -268,9 +269,9 @@ mod tests {
         assert_eq!(bin_of(-1.0, 0.0, 1.0, 8), 0);
         // The three-lane placement is the one-lane one, whatever the value.
         let odd = [f32::NAN, f32::INFINITY, f32::NEG_INFINITY, -1.0, -0.0, 0.0, 0.99, 1.0, 6.5, 7.0, 7.99, 8.0, 1e30];
+        let (min, scale) = (Vec3A::new(0.0, 0.5, -2.0), Vec3A::new(1.0, 2.0, 0.25));
         for (i, &x) in odd.iter().enumerate() {
             let (y, z) = (odd[(i + 3) % odd.len()], odd[(i + 7) % odd.len()]);
-            let (min, scale) = (Vec3A::new(0.0, 0.5, -2.0), Vec3A::new(1.0, 2.0, 0.25));
             let got = bin_vector(Vec3A::new(x, y, z), min, scale, Vec3A::splat(7.0));
             let expected =
                 [x, y, z].iter().enumerate().map(|(a, &c)| bin_of(c, min[a], scale[a], 8) as u32).collect::<Vec<_>>();
