@@ -1,11 +1,12 @@
 //! The triangle fast path on mesh files: build time (median of five builds, in triangles per
 //! second), wide nodes, leaves, triangles per leaf and per block, bytes, and the work of random
-//! rays (wide nodes visited and triangles tested per ray). Where `docs/performance.md`'s structure
+//! rays, closest and any hit (wide nodes visited and triangles tested per ray). Where `docs/performance.md`'s structure
 //! figures come from:
 //!
 //! ```sh
 //! cargo run --release -p englobe-cli --example triangle_bvh_stats -- \
-//!     ../shared/scenes/meshes/bunny/stanford-bunny.obj ../shared/scenes/meshes/ogre/ogre.obj
+//!     ../shared/scenes/meshes/bunny/stanford-bunny.obj ../shared/scenes/meshes/ogre/ogre.obj \
+//!     ../shared/scenes/meshes/sponza-dabrovic/sponza.obj
 //! ```
 
 use std::path::Path;
@@ -50,19 +51,28 @@ fn main() -> anyhow::Result<()> {
         let (lo, extent) = (mesh.bounds().min, mesh.bounds().extent());
         let mut rng = Pcg32::seed_from_u64(0x9e37_79b9_7f4a_7c15);
         let mut next = move || (rng.next_u32() >> 8) as f32 / (1u32 << 24) as f32;
+        let rays: Vec<Ray> = (0..100_000)
+            .map(|_| {
+                let o = lo + extent * Vec3::new(next(), next(), next());
+                Ray::new(o, Vec3::new(next() - 0.5, next() - 0.5, next() - 0.5))
+            })
+            .collect();
+        let n = rays.len() as f64;
         let mut c = WorkCounts::default();
-        let n = 100_000;
-        let mut hits = 0;
-        for _ in 0..n {
-            let o = lo + extent * Vec3::new(next(), next(), next());
-            let d = Vec3::new(next() - 0.5, next() - 0.5, next() - 0.5);
-            hits += bvh.closest_hit(&Ray::new(o, d), &mut c).is_some() as u32;
-        }
+        let hits = rays.iter().filter(|ray| bvh.closest_hit(ray, &mut c).is_some()).count();
         println!(
             "  random rays, closest hit: {:.1} wide nodes and {:.1} triangles tested per ray ({:.1} % hit)",
-            c.nodes_visited as f64 / n as f64,
-            c.exact_tests as f64 / n as f64,
-            100.0 * hits as f64 / n as f64
+            c.nodes_visited as f64 / n,
+            c.exact_tests as f64 / n,
+            100.0 * hits as f64 / n
+        );
+        let mut c = WorkCounts::default();
+        let hits = rays.iter().filter(|ray| bvh.any_hit(ray, &mut c)).count();
+        println!(
+            "  the same rays, any hit: {:.1} wide nodes and {:.1} triangles tested per ray ({:.1} % hit)",
+            c.nodes_visited as f64 / n,
+            c.exact_tests as f64 / n,
+            100.0 * hits as f64 / n
         );
     }
     Ok(())

@@ -169,7 +169,12 @@ unsafe fn walk<K: PacketKernel, C: Counters, L: PacketLeaves<C>>(
             if mask != 0 {
                 prefetch_children_of(nodes, node, mask, |first| leaves.prefetch(first));
                 let n = sorted_children(&hits, mask, &mut order);
-                // The farther ones pushed farthest first, the nearest taken now.
+                if !closest {
+                    // Occlusion: the farthest first, as the single-ray walk does (see
+                    // `super::traverse`).
+                    order[..n].reverse();
+                }
+                // The others pushed last-taken first, the first one taken now.
                 for &c in order[1..n].iter().rev() {
                     let c = c as usize;
                     debug_assert!(len < ENTRIES, "the stack holds seven entries per level");

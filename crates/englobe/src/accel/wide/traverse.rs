@@ -6,8 +6,13 @@
 //! et al. 2014): no sorting at all when one child or two are hit (the common cases), a short
 //! insertion sort of the hit children otherwise.
 //!
-//! Occlusion queries stop at the first occluder and do not sort: they enter the nearest child hit
-//! first (the likeliest to hold an occluder) and push the others as they come.
+//! Occlusion queries stop at the first occluder and do not sort: they enter the *farthest* child
+//! hit first and push the others as they come. A ray's far boxes are where the surfaces that close
+//! a scene lie (walls, floors, the far side of a mesh), which nearly every ray that is occluded at
+//! all meets; its near boxes hold the small geometry around its origin, which it mostly passes by.
+//! Measured against nearest first (the example `triangle_bvh_stats`, and the renderer's `--stats`),
+//! it visits 28 % fewer nodes on random rays in the Sponza, 16 % fewer on its shadow rays, and
+//! never more on the other meshes and scenes (see `docs/performance.md`).
 //!
 //! The traversal is generic over the node test ([`NodeKernel`], one per instruction set) and over
 //! what leaves hold ([`Leaves`]: primitive references tested by a closure, or blocks of
@@ -261,14 +266,14 @@ pub unsafe fn any<K: NodeKernel, C: Counters, L: Leaves<C>>(
                 let mut mask = unsafe { kernel.children(node, ray, limit, &mut dist) };
                 prefetch_children(nodes, node, mask, leaves);
                 if mask != 0 {
-                    // The nearest child first (it is the likeliest to hold an occluder), the
-                    // others pushed as they come.
-                    let mut nearest = mask.trailing_zeros() as usize;
+                    // The farthest child first (the likeliest to hold an occluder: see the
+                    // module documentation), the others pushed as they come.
+                    let mut farthest = mask.trailing_zeros() as usize;
                     mask &= mask - 1;
                     while mask != 0 {
                         let i = mask.trailing_zeros() as usize;
                         mask &= mask - 1;
-                        let push = if dist[i] < dist[nearest] { std::mem::replace(&mut nearest, i) } else { i };
+                        let push = if dist[i] > dist[farthest] { std::mem::replace(&mut farthest, i) } else { i };
                         stack[len].write(Entry {
                             reference: node.children[push],
                             count: node.counts[push] as u32,
@@ -276,7 +281,7 @@ pub unsafe fn any<K: NodeKernel, C: Counters, L: Leaves<C>>(
                         });
                         len += 1;
                     }
-                    current = Entry { reference: node.children[nearest], count: node.counts[nearest] as u32, t: 0.0 };
+                    current = Entry { reference: node.children[farthest], count: node.counts[farthest] as u32, t: 0.0 };
                     continue;
                 }
             }
