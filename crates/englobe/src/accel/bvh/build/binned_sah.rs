@@ -13,7 +13,7 @@
 //! `C_i * N`. When the centroids coincide, no plane separates them and the shared top-down driver
 //! ([`super::top_down`]) splits by count. Large subtrees are built in parallel.
 
-use glam::Vec3A;
+use glam::{BVec4A, Vec3A, Vec4};
 
 use super::top_down::{self, PrimRef, Splitter, partition, split_beats_leaf};
 use crate::Aabb;
@@ -93,21 +93,31 @@ impl Bin {
         self.count += other.count;
     }
 
-    /// Surface area times count ([`Aabb::surface_area`]'s formula; only called on bins holding
-    /// primitives, whose boxes are not empty).
-    #[inline(always)]
+    /// Surface area times count ([`Aabb::surface_area`]'s formula): the one-box form that
+    /// [`weighted_areas`] is tested against.
+    #[cfg(test)]
     fn weighted_area(&self) -> f32 {
         let e = self.max - self.min;
         2.0 * (e.x * e.y + e.y * e.z + e.z * e.x) * self.count as f32
     }
 }
 
-/// The bin of coordinate `c` among `bins` bins starting at `min`, `scale` bins per unit. The same
-/// function places primitives and partitions them, so the two always agree; a NaN or an out of
-/// range value saturates into the first or last bin instead of panicking.
-#[inline(always)]
+/// The bin of coordinate `c` among `bins` bins starting at `min`, `scale` bins per unit; a NaN or
+/// an out of range value saturates into the first or last bin. The rule the builder's two fast
+/// forms ([`bin_vector`], which places primitives, and [`before_plane`], which partitions them)
+/// are tested against, so that placement and partition always agree.
+#[cfg(test)]
 fn bin_of(c: f32, min: f32, scale: f32, bins: usize) -> usize {
     (((c - min) * scale) as usize).min(bins - 1)
+}
+
+/// Whether coordinate `c` falls in a bin before `plane` (`bin_of(c, min, scale, bins) < plane`
+/// for any `plane` in `1..bins`) as one comparison: the bin is the integer part of the product
+/// (0 for a negative product or NaN), so it is below the integer `plane` exactly when the product
+/// is, or is NaN.
+#[inline(always)]
+fn before_plane(c: f32, min: f32, scale: f32, plane: f32) -> bool {
+    !((c - min) * scale >= plane)
 }
 
 /// [`bin_of`] on the three coordinates of `c` at once, `last` being `bins - 1` in each lane: the
@@ -126,6 +136,58 @@ fn bin_vector(c: Vec3A, min: Vec3A, scale: Vec3A, last: Vec3A) -> [u32; 3] {
     }
     #[cfg(not(target_arch = "x86_64"))]
     clamped.as_uvec3().to_array()
+}
+
+/// The weighted areas ([`Bin::weighted_area`], computed as it computes them) of three boxes, lane
+/// `a` the box of axis `a`'s bins, and their counts.
+#[inline(always)]
+fn weighted_areas(sides: &[Bin; 3]) -> (Vec4, Vec4) {
+    let e = sides.map(|b| b.max - b.min);
+    let lanes = |f: fn(Vec3A) -> f32| Vec4::new(f(e[0]), f(e[1]), f(e[2]), 0.0);
+    let (ex, ey, ez) = (lanes(|v| v.x), lanes(|v| v.y), lanes(|v| v.z));
+    let count = Vec4::new(sides[0].count as f32, sides[1].count as f32, sides[2].count as f32, 0.0);
+    (Vec4::splat(2.0) * (ex * ey + ey * ez + ez * ex) * count, count)
+}
+
+/// The best plane among the first `k` bins of each axis that `splittable` allows: (area-weighted
+/// count of both sides, axis, first bin of the second side). The three axes are swept at once,
+/// one per vector lane (as Embree's binner does); each lane keeps the first plane of least cost,
+/// and the axes are then compared in order, so the plane is the one a sweep of axis 0, then 1,
+/// then 2 would keep (the first of least cost).
+fn best_plane(bins: &[[Bin; MAX_BINS]; 3], k: usize, splittable: [bool; 3]) -> Option<(f32, usize, usize)> {
+    // right[i]: area times count of bins i.. of each axis (for the planes before bin i, i in
+    // 1..k), NaN where they are empty.
+    let mut right = [Vec4::NAN; MAX_BINS];
+    let mut side = [EMPTY_BIN; 3];
+    for i in (1..k).rev() {
+        for (s, axis) in side.iter_mut().zip(bins) {
+            s.merge(&axis[i]);
+        }
+        let (weighted, count) = weighted_areas(&side);
+        right[i] = Vec4::select(count.cmpeq(Vec4::ZERO), Vec4::NAN, weighted);
+    }
+    let allowed = BVec4A::new(splittable[0], splittable[1], splittable[2], false);
+    let (mut cost, mut plane, mut found) = (Vec4::ZERO, Vec4::ZERO, BVec4A::splat(false));
+    let mut side = [EMPTY_BIN; 3];
+    for i in 1..k {
+        for (s, axis) in side.iter_mut().zip(bins) {
+            s.merge(&axis[i - 1]);
+        }
+        let (weighted, count) = weighted_areas(&side);
+        let valid = allowed & count.cmpne(Vec4::ZERO) & !right[i].is_nan_mask();
+        let here = weighted + right[i];
+        let better = valid & (!found | here.cmplt(cost));
+        cost = Vec4::select(better, here, cost);
+        plane = Vec4::select(better, Vec4::splat(i as f32), plane);
+        found |= valid;
+    }
+    let mut best: Option<(f32, usize, usize)> = None;
+    for axis in (0..3).filter(|&a| found.test(a)) {
+        if best.is_none_or(|(c, _, _)| cost[axis] < c) {
+            best = Some((cost[axis], axis, plane[axis] as usize));
+        }
+    }
+    best
 }
 
 impl Splitter for BinnedSah {
@@ -173,35 +235,14 @@ impl Splitter for BinnedSah {
             }
         }
 
-        // Best plane: (area-weighted count of both sides, axis, first bin of the second side).
-        let mut best: Option<(f32, usize, usize)> = None;
-        for axis in (0..3).filter(|&a| scale[a] > 0.0) {
-            let bins = &bins[axis][..k];
-            // right[i]: area times count of bins i.. (for the planes before bin i, i in 1..k).
-            let mut right = [0.0f32; MAX_BINS];
-            let mut side = EMPTY_BIN;
-            for i in (1..k).rev() {
-                side.merge(&bins[i]);
-                right[i] = if side.count == 0 { f32::NAN } else { side.weighted_area() };
-            }
-            let mut side = EMPTY_BIN;
-            for i in 1..k {
-                side.merge(&bins[i - 1]);
-                if side.count == 0 || right[i].is_nan() {
-                    continue;
-                }
-                let cost = side.weighted_area() + right[i];
-                if best.is_none_or(|(c, _, _)| cost < c) {
-                    best = Some((cost, axis, i));
-                }
-            }
-        }
+        let splittable = scale.map(|s| s > 0.0);
+        let best = best_plane(bins, k, splittable);
         let (weighted, axis, plane) = best?;
         if !must_split && !split_beats_leaf(weighted, bounds.surface_area(), refs.len()) {
             return None;
         }
-        let (lo, s) = (min[axis], scale[axis]);
-        Some(partition(refs, |r| bin_of(r.centroid_on(axis), lo, s, k) < plane))
+        let (lo, s, plane) = (min[axis], scale[axis], plane as f32);
+        Some(partition(refs, |r| before_plane(r.centroid_on(axis), lo, s, plane)))
     }
 }
 
@@ -276,6 +317,33 @@ mod tests {
             let expected =
                 [x, y, z].iter().enumerate().map(|(a, &c)| bin_of(c, min[a], scale[a], 8) as u32).collect::<Vec<_>>();
             assert_eq!(got.to_vec(), expected, "{x} {y} {z}");
+            // The partition's comparison is the placement's, at every plane.
+            for plane in 1..8 {
+                let before = before_plane(x, min.x, scale.x, plane as f32);
+                assert_eq!(before, bin_of(x, min.x, scale.x, 8) < plane, "{x} at plane {plane}");
+            }
+        }
+    }
+
+    #[test]
+    fn the_three_lane_areas_are_the_one_box_areas_bit_for_bit() {
+        let mut state = 0x2545_f491_u32;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 17;
+            state ^= state << 5;
+            (state >> 8) as f32 / (1 << 24) as f32 * 200.0 - 100.0
+        };
+        for _ in 0..1000 {
+            let sides = [0, 1, 2].map(|_| {
+                let (a, b) = (Vec3A::new(next(), next(), next()), Vec3A::new(next(), next(), next()));
+                Bin { min: a.min(b), max: a.max(b), count: (next().abs() * 1000.0) as u32 }
+            });
+            let (weighted, count) = weighted_areas(&sides);
+            for (axis, side) in sides.iter().enumerate() {
+                assert_eq!(weighted[axis].to_bits(), side.weighted_area().to_bits(), "{side:?}");
+                assert_eq!(count[axis], side.count as f32);
+            }
         }
     }
 

@@ -246,23 +246,25 @@ pub fn split_beats_leaf(weighted: f32, area: f32, n: usize) -> bool {
 }
 
 /// Reorders `refs` so that those for which `left` holds come first; returns how many they are.
-/// (Hoare's two-pointer partition: linear, in place, not stable, deterministic.)
+///
+/// Lomuto's scheme without a branch on the outcome (Edelkamp and Weiß (2016), "BlockQuicksort:
+/// How Branch Mispredictions don't affect Quicksort", whose analysis this follows; Alexandrescu's
+/// "Lomuto's Comeback" gives this loop): every reference is swapped with the first one not chosen,
+/// and the boundary advances by the outcome. Which side a reference goes to follows no pattern, so
+/// the branches of Hoare's two-pointer scheme would mispredict about once per reference; this
+/// loop moves more bytes and mispredicts never. Linear, in place, not stable, deterministic.
 pub fn partition(refs: &mut [PrimRef], mut left: impl FnMut(&PrimRef) -> bool) -> usize {
-    let (mut i, mut j) = (0usize, refs.len());
-    loop {
-        while i < j && left(&refs[i]) {
-            i += 1;
-        }
-        while i < j && !left(&refs[j - 1]) {
-            j -= 1;
-        }
-        if i >= j {
-            return i;
-        }
-        refs.swap(i, j - 1);
-        i += 1;
-        j -= 1;
+    let mut first = 0;
+    for i in 0..refs.len() {
+        let r = refs[i];
+        let goes_left = left(&r);
+        // `refs[first..i]` are all on the right: swapping `r` in at `first` keeps them there,
+        // and the boundary moves past `r` if it goes left.
+        refs[i] = refs[first];
+        refs[first] = r;
+        first += goes_left as usize;
     }
+    first
 }
 
 #[cfg(test)]
@@ -345,6 +347,11 @@ mod tests {
         assert_eq!(mid, 4);
         assert!(refs[..mid].iter().all(|r| r.index() % 3 == 0));
         assert!(refs[mid..].iter().all(|r| r.index() % 3 != 0));
+        // A permutation: every reference once, with its box.
+        let mut seen: Vec<u32> = refs.iter().map(|r| r.index()).collect();
+        seen.sort_unstable();
+        assert_eq!(seen, (0..11).collect::<Vec<_>>());
+        assert!(refs.iter().all(|r| r.bounds() == b[r.index() as usize]));
         assert_eq!(partition(&mut refs, |_| true), 11);
         assert_eq!(partition(&mut refs, |_| false), 0);
         assert_eq!(partition(&mut [], |_| true), 0);
