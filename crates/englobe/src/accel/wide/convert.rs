@@ -16,10 +16,82 @@
 //!
 //! The walk uses an explicit stack (degenerate trees as deep as they have primitives are fine), and
 //! the interior children of a node are stored next to one another, in slot order.
+//!
+//! The binary tree is read through [`BinaryTree`]: the laid-out [`Bvh`] of any builder, or the
+//! top-down builders' [`BuildTree`] as it comes out of the build, which spares the triangle
+//! structure the layout pass (and its per-node child ordering) that only the binary traversal
+//! needs.
 
 use super::node::{LEAF, MAX_LEAF_ITEMS, WIDTH, WideNode};
+use std::ops::Range;
+
 use crate::Aabb;
-use crate::accel::bvh::Bvh;
+use crate::accel::bvh::{BuildKind, BuildTree, Bvh};
+
+/// A binary tree as the conversion reads it.
+pub trait BinaryTree {
+    /// The root, or `None` for a tree without nodes.
+    fn root(&self) -> Option<u32>;
+    /// Slots of node indices (every node index is below it).
+    fn slots(&self) -> usize;
+    /// A node's box.
+    fn bounds(&self, node: u32) -> Aabb;
+    /// An interior node's first and second child; `None` for a leaf.
+    fn children(&self, node: u32) -> Option<[u32; 2]>;
+    /// A leaf's range in [`BinaryTree::prims`] (empty for an interior node).
+    fn leaf_range(&self, node: u32) -> Range<usize>;
+    /// The primitive references the leaves' ranges index.
+    fn prims(&self) -> &[u32];
+}
+
+impl BinaryTree for Bvh {
+    fn root(&self) -> Option<u32> {
+        (!self.nodes().is_empty()).then_some(0)
+    }
+    fn slots(&self) -> usize {
+        self.nodes().len()
+    }
+    fn bounds(&self, node: u32) -> Aabb {
+        self.nodes()[node as usize].bounds()
+    }
+    fn children(&self, node: u32) -> Option<[u32; 2]> {
+        let n = &self.nodes()[node as usize];
+        (!n.is_leaf()).then_some([node + 1, n.index])
+    }
+    fn leaf_range(&self, node: u32) -> Range<usize> {
+        self.nodes()[node as usize].prim_range()
+    }
+    fn prims(&self) -> &[u32] {
+        self.prim_indices()
+    }
+}
+
+impl BinaryTree for BuildTree {
+    fn root(&self) -> Option<u32> {
+        (!self.nodes.is_empty()).then_some(self.root)
+    }
+    fn slots(&self) -> usize {
+        self.nodes.len()
+    }
+    fn bounds(&self, node: u32) -> Aabb {
+        self.nodes[node as usize].bounds
+    }
+    fn children(&self, node: u32) -> Option<[u32; 2]> {
+        match self.nodes[node as usize].kind {
+            BuildKind::Interior { children } => Some(children),
+            BuildKind::Leaf { .. } => None,
+        }
+    }
+    fn leaf_range(&self, node: u32) -> Range<usize> {
+        match self.nodes[node as usize].kind {
+            BuildKind::Leaf { first, count } => first as usize..(first + count) as usize,
+            BuildKind::Interior { .. } => 0..0,
+        }
+    }
+    fn prims(&self) -> &[u32] {
+        &self.prims
+    }
+}
 
 /// Where the leaves of a conversion go.
 pub trait LeafSink {
@@ -61,22 +133,34 @@ enum Part {
     },
 }
 
-/// Converts `bvh` into wide nodes, its leaves stored through `sink`.
-pub fn convert(bvh: &Bvh, options: ConvertOptions, sink: &mut impl LeafSink) -> WideLayout {
-    let bin = bvh.nodes();
-    if bin.is_empty() {
+/// Converts `tree` into wide nodes, its leaves stored through `sink`.
+pub fn convert(tree: &impl BinaryTree, options: ConvertOptions, sink: &mut impl LeafSink) -> WideLayout {
+    let Some(root) = tree.root() else {
         return WideLayout::default();
-    }
+    };
     let max_prims = sink.max_prims().clamp(1, MAX_LEAF_ITEMS);
-    // Primitives under each binary node (children lie after their parent: one reverse pass).
-    let mut count = vec![0u32; bin.len()];
-    for i in (0..bin.len()).rev() {
-        let n = &bin[i];
-        count[i] = if n.is_leaf() { n.prim_count() } else { count[i + 1] + count[n.index as usize] };
+    // Primitives under each node: the nodes in depth-first order, then counted from the last
+    // (every node's children come after it in that order).
+    let mut order = Vec::with_capacity(tree.slots());
+    let mut stack = vec![root];
+    while let Some(i) = stack.pop() {
+        order.push(i);
+        if let Some([first, second]) = tree.children(i) {
+            stack.push(second);
+            stack.push(first);
+        }
     }
+    let mut count = vec![0u32; tree.slots()];
+    for &i in order.iter().rev() {
+        count[i as usize] = match tree.children(i) {
+            Some([first, second]) => count[first as usize] + count[second as usize],
+            None => tree.leaf_range(i).len() as u32,
+        };
+    }
+    drop(order);
     let limit = options.collapse.min(max_prims);
     let bounds_of = |p: &Part| match *p {
-        Part::Node(i) => bin[i as usize].bounds(),
+        Part::Node(i) => tree.bounds(i),
         Part::Range { bounds, .. } => bounds,
     };
     let prims_in = |p: &Part| match *p {
@@ -86,27 +170,25 @@ pub fn convert(bvh: &Bvh, options: ConvertOptions, sink: &mut impl LeafSink) -> 
     // A part is a leaf if it holds few enough primitives, an interior node otherwise.
     let terminal = |p: &Part| match *p {
         Part::Node(i) => {
-            let n = &bin[i as usize];
-            (n.is_leaf() && n.prim_count() as usize <= max_prims) || count[i as usize] as usize <= limit
+            (tree.children(i).is_none() && count[i as usize] as usize <= max_prims)
+                || count[i as usize] as usize <= limit
         }
         Part::Range { len, .. } => len as usize <= max_prims,
     };
     let open = |p: &Part| -> [Part; 2] {
         match *p {
-            Part::Node(i) => {
-                let n = &bin[i as usize];
-                if n.is_leaf() {
-                    let r = n.prim_range();
+            Part::Node(i) => match tree.children(i) {
+                Some([first, second]) => [Part::Node(first), Part::Node(second)],
+                None => {
+                    let r = tree.leaf_range(i);
                     let half = (r.len() / 2) as u32;
-                    let (start, len, bounds) = (r.start as u32, r.len() as u32, n.bounds());
+                    let (start, len, bounds) = (r.start as u32, r.len() as u32, tree.bounds(i));
                     [
                         Part::Range { start, len: half, bounds },
                         Part::Range { start: start + half, len: len - half, bounds },
                     ]
-                } else {
-                    [Part::Node(i + 1), Part::Node(n.index)]
                 }
-            }
+            },
             Part::Range { start, len, bounds } => {
                 let half = len / 2;
                 [Part::Range { start, len: half, bounds }, Part::Range { start: start + half, len: len - half, bounds }]
@@ -120,7 +202,7 @@ pub fn convert(bvh: &Bvh, options: ConvertOptions, sink: &mut impl LeafSink) -> 
     let (mut prims, mut pending) = (Vec::new(), Vec::new());
     let mut slots: Vec<Part> = Vec::with_capacity(WIDTH);
     // (wide node to fill, the part it stands for, its level from 1)
-    let mut stack: Vec<(usize, Part, u32)> = vec![(0, Part::Node(0), 1)];
+    let mut stack: Vec<(usize, Part, u32)> = vec![(0, Part::Node(root), 1)];
     while let Some((here, part, level)) = stack.pop() {
         depth = depth.max(level);
         slots.clear();
@@ -151,7 +233,7 @@ pub fn convert(bvh: &Bvh, options: ConvertOptions, sink: &mut impl LeafSink) -> 
             let bounds = bounds_of(p);
             if terminal(p) {
                 prims.clear();
-                gather(bvh, p, &mut prims, &mut pending);
+                gather(tree, p, &mut prims, &mut pending);
                 let (first, items) = sink.leaf(&prims);
                 node.set_child(slot, &bounds, LEAF | first, items);
             } else {
@@ -168,21 +250,19 @@ pub fn convert(bvh: &Bvh, options: ConvertOptions, sink: &mut impl LeafSink) -> 
 
 /// Appends the primitives under `part` to `out`, in the binary tree's leaf order (`stack` is
 /// working memory).
-fn gather(bvh: &Bvh, part: &Part, out: &mut Vec<u32>, stack: &mut Vec<u32>) {
+fn gather(tree: &impl BinaryTree, part: &Part, out: &mut Vec<u32>, stack: &mut Vec<u32>) {
     match *part {
-        Part::Range { start, len, .. } => {
-            out.extend_from_slice(&bvh.prim_indices()[start as usize..(start + len) as usize])
-        }
+        Part::Range { start, len, .. } => out.extend_from_slice(&tree.prims()[start as usize..(start + len) as usize]),
         Part::Node(i) => {
             stack.clear();
             stack.push(i);
             while let Some(i) = stack.pop() {
-                let n = &bvh.nodes()[i as usize];
-                if n.is_leaf() {
-                    out.extend_from_slice(&bvh.prim_indices()[n.prim_range()]);
-                } else {
-                    stack.push(n.index);
-                    stack.push(i + 1);
+                match tree.children(i) {
+                    Some([first, second]) => {
+                        stack.push(second);
+                        stack.push(first);
+                    }
+                    None => out.extend_from_slice(&tree.prims()[tree.leaf_range(i)]),
                 }
             }
         }
@@ -305,10 +385,31 @@ mod tests {
             nodes.push(BuildNode { bounds: all, kind: BuildKind::Interior { children: [i, next] } });
         }
         let boxes: Vec<Aabb> = nodes[..n as usize].iter().map(|b| b.bounds).collect();
-        let bvh = BuildTree { nodes, prims: (0..n).collect(), root: n }.into_bvh();
+        let tree = BuildTree { nodes, prims: (0..n).collect(), root: n };
         let mut sink = Refs { max: 8, refs: Vec::new() };
-        let layout = convert(&bvh, ConvertOptions { collapse: 0 }, &mut sink);
+        let layout = convert(&tree.clone().into_bvh(), ConvertOptions { collapse: 0 }, &mut sink);
         assert_eq!(check(&layout, &sink.refs, &boxes), layout.depth);
+        // The builder's tree read as it is (its children stored before their parents here): the
+        // same conversion.
+        let mut direct = Refs { max: 8, refs: Vec::new() };
+        assert_eq!(convert(&tree, ConvertOptions { collapse: 0 }, &mut direct), layout);
+        assert_eq!(direct.refs, sink.refs);
+    }
+
+    #[test]
+    fn a_build_tree_converts_as_its_layout_does() {
+        for n in [1usize, 2, 9, 100, 5000] {
+            let boxes = grid(n);
+            let tree = BinnedSah::default().build_tree(&boxes);
+            for collapse in [0, 4] {
+                let (mut laid_out, mut direct) = (Refs { max: 8, refs: Vec::new() }, Refs { max: 8, refs: Vec::new() });
+                let expected = convert(&tree.clone().into_bvh(), ConvertOptions { collapse }, &mut laid_out);
+                assert_eq!(convert(&tree, ConvertOptions { collapse }, &mut direct), expected, "n = {n}");
+                assert_eq!(direct.refs, laid_out.refs, "n = {n}");
+            }
+        }
+        let mut sink = Refs { max: 8, refs: Vec::new() };
+        assert_eq!(convert(&BuildTree::default(), ConvertOptions { collapse: 4 }, &mut sink), WideLayout::default());
     }
 
     #[test]

@@ -8,7 +8,7 @@
 
 use glam::Vec3;
 
-use super::convert::{ConvertOptions, LeafSink, convert};
+use super::convert::{BinaryTree, ConvertOptions, LeafSink, convert};
 use super::dispatch;
 use super::isa::{Isa, IsaUnavailable};
 use super::node::{NodeRay, WideNode, may_enter, reach};
@@ -188,15 +188,16 @@ impl TriangleBvh {
         let kept: Vec<Aabb> = if ids.len() == count { boxes } else { ids.iter().map(|&i| boxes[i as usize]).collect() };
         let budget = options.presplit_percent as f32 / 100.0;
         let fragments = presplit(&kept, |i| triangle(ids[i as usize]), budget);
-        let bvh = options.builder.build(&fragments.boxes);
+        // The builder's tree as it comes, without the binary layout: only its wide form is kept.
+        let tree = options.builder.build_tree(&fragments.boxes);
         let owners: Vec<u32> = fragments.owner.iter().map(|&k| ids[k as usize]).collect();
         let mut sink = Blocks { ids: &owners, blocks: Vec::new(), leaf_ids: Vec::new() };
-        let layout = convert(&bvh, ConvertOptions { collapse: options.collapse }, &mut sink);
+        let layout = convert(&tree, ConvertOptions { collapse: options.collapse }, &mut sink);
         let mut built = TriangleBvh {
             nodes: layout.nodes,
             blocks: sink.fill(&triangle),
             depth: layout.depth,
-            bounds: bvh.bounds(),
+            bounds: tree.root().map_or(Aabb::EMPTY, |root| tree.bounds(root)),
             stored: ids.len(),
             count,
             cut: fragments.boxes.len() > kept.len(),
