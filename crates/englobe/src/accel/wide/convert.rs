@@ -17,81 +17,14 @@
 //! The walk uses an explicit stack (degenerate trees as deep as they have primitives are fine), and
 //! the interior children of a node are stored next to one another, in slot order.
 //!
-//! The binary tree is read through [`BinaryTree`]: the laid-out [`Bvh`] of any builder, or the
-//! top-down builders' [`BuildTree`] as it comes out of the build, which spares the triangle
-//! structure the layout pass (and its per-node child ordering) that only the binary traversal
-//! needs.
+//! The binary tree is read through [`BinaryTree`] (the laid-out `Bvh` of any builder, or the
+//! top-down builders' `BuildTree` as it comes out of the build). A large tree's subtrees below the
+//! root are converted in parallel (see [`convert`]).
 
-use super::node::{LEAF, MAX_LEAF_ITEMS, WIDTH, WideNode};
-use std::ops::Range;
-
+pub use super::binary::BinaryTree;
+use super::node::{EMPTY, LEAF, MAX_LEAF_ITEMS, WIDTH, WideNode, index_of, is_leaf};
 use crate::Aabb;
-use crate::accel::bvh::{BuildKind, BuildTree, Bvh};
-
-/// A binary tree as the conversion reads it.
-pub trait BinaryTree {
-    /// The root, or `None` for a tree without nodes.
-    fn root(&self) -> Option<u32>;
-    /// Slots of node indices (every node index is below it).
-    fn slots(&self) -> usize;
-    /// A node's box.
-    fn bounds(&self, node: u32) -> Aabb;
-    /// An interior node's first and second child; `None` for a leaf.
-    fn children(&self, node: u32) -> Option<[u32; 2]>;
-    /// A leaf's range in [`BinaryTree::prims`] (empty for an interior node).
-    fn leaf_range(&self, node: u32) -> Range<usize>;
-    /// The primitive references the leaves' ranges index.
-    fn prims(&self) -> &[u32];
-}
-
-impl BinaryTree for Bvh {
-    fn root(&self) -> Option<u32> {
-        (!self.nodes().is_empty()).then_some(0)
-    }
-    fn slots(&self) -> usize {
-        self.nodes().len()
-    }
-    fn bounds(&self, node: u32) -> Aabb {
-        self.nodes()[node as usize].bounds()
-    }
-    fn children(&self, node: u32) -> Option<[u32; 2]> {
-        let n = &self.nodes()[node as usize];
-        (!n.is_leaf()).then_some([node + 1, n.index])
-    }
-    fn leaf_range(&self, node: u32) -> Range<usize> {
-        self.nodes()[node as usize].prim_range()
-    }
-    fn prims(&self) -> &[u32] {
-        self.prim_indices()
-    }
-}
-
-impl BinaryTree for BuildTree {
-    fn root(&self) -> Option<u32> {
-        (!self.nodes.is_empty()).then_some(self.root)
-    }
-    fn slots(&self) -> usize {
-        self.nodes.len()
-    }
-    fn bounds(&self, node: u32) -> Aabb {
-        self.nodes[node as usize].bounds
-    }
-    fn children(&self, node: u32) -> Option<[u32; 2]> {
-        match self.nodes[node as usize].kind {
-            BuildKind::Interior { children } => Some(children),
-            BuildKind::Leaf { .. } => None,
-        }
-    }
-    fn leaf_range(&self, node: u32) -> Range<usize> {
-        match self.nodes[node as usize].kind {
-            BuildKind::Leaf { first, count } => first as usize..(first + count) as usize,
-            BuildKind::Interior { .. } => 0..0,
-        }
-    }
-    fn prims(&self) -> &[u32] {
-        &self.prims
-    }
-}
+use crate::accel::bvh::build::parallel::fill_indexed;
 
 /// Where the leaves of a conversion go.
 pub trait LeafSink {
@@ -101,6 +34,15 @@ pub trait LeafSink {
     /// Stores a leaf over the primitives `prims` (at most [`LeafSink::max_prims`]); returns the
     /// index of its first item and its number of items.
     fn leaf(&mut self, prims: &[u32]) -> (u32, u8);
+    /// An empty sink like this one, for a subtree converted on another thread.
+    fn split(&self) -> Self
+    where
+        Self: Sized;
+    /// Appends the items of `other` (a [`LeafSink::split`] of this sink) after this one's;
+    /// returns the index their first item now has.
+    fn join(&mut self, other: Self) -> u32
+    where
+        Self: Sized;
 }
 
 /// How binary nodes become wide nodes and leaves.
@@ -133,56 +75,137 @@ enum Part {
     },
 }
 
+/// Trees over at least this many primitives convert the subtrees under the root in parallel.
+const PARALLEL_MIN: u32 = 1 << 14;
+
 /// Converts `tree` into wide nodes, its leaves stored through `sink`.
-pub fn convert(tree: &impl BinaryTree, options: ConvertOptions, sink: &mut impl LeafSink) -> WideLayout {
+///
+/// A large tree's root node is made first; the subtrees of its interior children are then
+/// converted in parallel, each into nodes and items of its own, and appended in slot order (their
+/// references moved past the nodes and items before them). The tree is the one a single walk
+/// makes; only the order in which nodes and items are stored differs (each subtree's together).
+pub fn convert<T, S>(tree: &T, options: ConvertOptions, sink: &mut S) -> WideLayout
+where
+    T: BinaryTree + Sync,
+    S: LeafSink + Send + Sync,
+{
     let Some(root) = tree.root() else {
         return WideLayout::default();
     };
-    let max_prims = sink.max_prims().clamp(1, MAX_LEAF_ITEMS);
-    // Primitives under each node: the nodes in depth-first order, then counted from the last
-    // (every node's children come after it in that order).
-    let mut order = Vec::with_capacity(tree.slots());
-    let mut stack = vec![root];
-    while let Some(i) = stack.pop() {
-        order.push(i);
-        if let Some([first, second]) = tree.children(i) {
-            stack.push(second);
-            stack.push(first);
+    let walker = Walker::new(tree, options, sink.max_prims());
+    if walker.count[root as usize] < PARALLEL_MIN {
+        return walker.walk(Part::Node(root), sink);
+    }
+    let mut slots = Vec::with_capacity(WIDTH);
+    walker.fill_slots(Part::Node(root), &mut slots);
+    let mut node = WideNode::EMPTY_NODE;
+    let (mut prims, mut pending) = (Vec::new(), Vec::new());
+    let mut subtrees = Vec::new();
+    for (slot, p) in slots.iter().enumerate() {
+        if walker.terminal(p) {
+            let (first, items) = walker.leaf(p, sink, &mut prims, &mut pending);
+            node.set_child(slot, &walker.bounds_of(p), LEAF | first, items);
+        } else {
+            subtrees.push((slot, *p));
         }
     }
-    let mut count = vec![0u32; tree.slots()];
-    for &i in order.iter().rev() {
-        count[i as usize] = match tree.children(i) {
-            Some([first, second]) => count[first as usize] + count[second as usize],
-            None => tree.leaf_range(i).len() as u32,
-        };
+    let mut converted: Vec<Option<(WideLayout, S)>> = subtrees.iter().map(|_| None).collect();
+    let template = &*sink;
+    fill_indexed(&mut converted, 1, |i| {
+        let mut items = template.split();
+        Some((walker.walk(subtrees[i].1, &mut items), items))
+    });
+    let mut nodes = vec![WideNode::EMPTY_NODE];
+    let mut depth = 1;
+    for (&(slot, p), done) in subtrees.iter().zip(converted) {
+        let (layout, items) = done.expect("every subtree is converted");
+        let first_node = nodes.len() as u32;
+        let first_item = sink.join(items);
+        node.set_child(slot, &walker.bounds_of(&p), first_node, 0);
+        nodes.extend(layout.nodes.into_iter().map(|n| relocate(n, first_node, first_item)));
+        depth = depth.max(1 + layout.depth);
     }
-    drop(order);
-    let limit = options.collapse.min(max_prims);
-    let bounds_of = |p: &Part| match *p {
-        Part::Node(i) => tree.bounds(i),
-        Part::Range { bounds, .. } => bounds,
-    };
-    let prims_in = |p: &Part| match *p {
-        Part::Node(i) => count[i as usize],
-        Part::Range { len, .. } => len,
-    };
-    // A part is a leaf if it holds few enough primitives, an interior node otherwise.
-    let terminal = |p: &Part| match *p {
-        Part::Node(i) => {
-            (tree.children(i).is_none() && count[i as usize] as usize <= max_prims)
-                || count[i as usize] as usize <= limit
+    nodes[0] = node;
+    WideLayout { nodes, depth }
+}
+
+/// `node` moved `nodes` nodes and `items` leaf items further: its references follow.
+fn relocate(mut node: WideNode, nodes: u32, items: u32) -> WideNode {
+    for c in node.children.iter_mut().filter(|c| **c != EMPTY) {
+        *c = if is_leaf(*c) { LEAF | (index_of(*c) + items) } else { *c + nodes };
+    }
+    node
+}
+
+/// The conversion's view of a binary tree: its primitive counts and leaf limits.
+struct Walker<'a, T> {
+    tree: &'a T,
+    /// Primitives under each binary node.
+    count: Vec<u32>,
+    /// Most primitives per leaf.
+    max_prims: usize,
+    /// Subtrees over at most this many primitives become one leaf.
+    limit: usize,
+}
+
+impl<'a, T: BinaryTree> Walker<'a, T> {
+    fn new(tree: &'a T, options: ConvertOptions, max_prims: usize) -> Self {
+        let max_prims = max_prims.clamp(1, MAX_LEAF_ITEMS);
+        // Primitives under each node: the nodes in depth-first order, then counted from the last
+        // (every node's children come after it in that order).
+        let mut order = Vec::with_capacity(tree.slots());
+        let mut stack: Vec<u32> = tree.root().into_iter().collect();
+        while let Some(i) = stack.pop() {
+            order.push(i);
+            if let Some([first, second]) = tree.children(i) {
+                stack.push(second);
+                stack.push(first);
+            }
         }
-        Part::Range { len, .. } => len as usize <= max_prims,
-    };
-    let open = |p: &Part| -> [Part; 2] {
+        let mut count = vec![0u32; tree.slots()];
+        for &i in order.iter().rev() {
+            count[i as usize] = match tree.children(i) {
+                Some([first, second]) => count[first as usize] + count[second as usize],
+                None => tree.leaf_range(i).len() as u32,
+            };
+        }
+        Walker { tree, count, max_prims, limit: options.collapse.min(max_prims) }
+    }
+
+    fn bounds_of(&self, p: &Part) -> Aabb {
         match *p {
-            Part::Node(i) => match tree.children(i) {
+            Part::Node(i) => self.tree.bounds(i),
+            Part::Range { bounds, .. } => bounds,
+        }
+    }
+
+    fn prims_in(&self, p: &Part) -> u32 {
+        match *p {
+            Part::Node(i) => self.count[i as usize],
+            Part::Range { len, .. } => len,
+        }
+    }
+
+    /// Whether a part is a leaf (it holds few enough primitives) rather than an interior node.
+    fn terminal(&self, p: &Part) -> bool {
+        match *p {
+            Part::Node(i) => {
+                let n = self.count[i as usize] as usize;
+                (self.tree.children(i).is_none() && n <= self.max_prims) || n <= self.limit
+            }
+            Part::Range { len, .. } => len as usize <= self.max_prims,
+        }
+    }
+
+    /// A part's two halves: a node's children, or a leaf's primitives cut in two.
+    fn open(&self, p: &Part) -> [Part; 2] {
+        match *p {
+            Part::Node(i) => match self.tree.children(i) {
                 Some([first, second]) => [Part::Node(first), Part::Node(second)],
                 None => {
-                    let r = tree.leaf_range(i);
+                    let r = self.tree.leaf_range(i);
                     let half = (r.len() / 2) as u32;
-                    let (start, len, bounds) = (r.start as u32, r.len() as u32, tree.bounds(i));
+                    let (start, len, bounds) = (r.start as u32, r.len() as u32, self.tree.bounds(i));
                     [
                         Part::Range { start, len: half, bounds },
                         Part::Range { start: start + half, len: len - half, bounds },
@@ -194,22 +217,16 @@ pub fn convert(tree: &impl BinaryTree, options: ConvertOptions, sink: &mut impl 
                 [Part::Range { start, len: half, bounds }, Part::Range { start: start + half, len: len - half, bounds }]
             }
         }
-    };
+    }
 
-    let mut nodes = vec![WideNode::EMPTY_NODE];
-    let mut depth = 1;
-    // Working lists kept from node to node (a build converts tens of thousands of nodes).
-    let (mut prims, mut pending) = (Vec::new(), Vec::new());
-    let mut slots: Vec<Part> = Vec::with_capacity(WIDTH);
-    // (wide node to fill, the part it stands for, its level from 1)
-    let mut stack: Vec<(usize, Part, u32)> = vec![(0, Part::Node(root), 1)];
-    while let Some((here, part, level)) = stack.pop() {
-        depth = depth.max(level);
+    /// The children of the wide node standing for `part`: its halves, the widest non-leaf one
+    /// opened in turn until eight slots are used or only leaves are left.
+    fn fill_slots(&self, part: Part, slots: &mut Vec<Part>) {
         slots.clear();
-        if terminal(&part) {
+        if self.terminal(&part) {
             slots.push(part);
         } else {
-            slots.extend(open(&part));
+            slots.extend(self.open(&part));
         }
         while slots.len() < WIDTH {
             // Of equal boxes (pieces of one large leaf), the one with the most primitives: halving
@@ -217,35 +234,55 @@ pub fn convert(tree: &impl BinaryTree, options: ConvertOptions, sink: &mut impl 
             let widest = slots
                 .iter()
                 .enumerate()
-                .filter(|(_, p)| !terminal(p))
+                .filter(|(_, p)| !self.terminal(p))
                 .max_by(|(_, a), (_, b)| {
-                    let area = bounds_of(a).surface_area().total_cmp(&bounds_of(b).surface_area());
-                    area.then(prims_in(a).cmp(&prims_in(b)))
+                    let area = self.bounds_of(a).surface_area().total_cmp(&self.bounds_of(b).surface_area());
+                    area.then(self.prims_in(a).cmp(&self.prims_in(b)))
                 })
                 .map(|(i, _)| i);
             let Some(i) = widest else { break };
-            let [first, second] = open(&slots[i]);
+            let [first, second] = self.open(&slots[i]);
             slots[i] = first;
             slots.insert(i + 1, second);
         }
-        let mut node = WideNode::EMPTY_NODE;
-        for (slot, p) in slots.iter().enumerate() {
-            let bounds = bounds_of(p);
-            if terminal(p) {
-                prims.clear();
-                gather(tree, p, &mut prims, &mut pending);
-                let (first, items) = sink.leaf(&prims);
-                node.set_child(slot, &bounds, LEAF | first, items);
-            } else {
-                let child = nodes.len();
-                nodes.push(WideNode::EMPTY_NODE);
-                node.set_child(slot, &bounds, child as u32, 0);
-                stack.push((child, *p, level + 1));
-            }
-        }
-        nodes[here] = node;
     }
-    WideLayout { nodes, depth }
+
+    /// Stores the leaf part `p` through `sink` (`prims` and `pending` are working memory).
+    fn leaf(&self, p: &Part, sink: &mut impl LeafSink, prims: &mut Vec<u32>, pending: &mut Vec<u32>) -> (u32, u8) {
+        prims.clear();
+        gather(self.tree, p, prims, pending);
+        sink.leaf(prims)
+    }
+
+    /// The wide subtree standing for `part` (its root is node 0), in one walk.
+    fn walk(&self, part: Part, sink: &mut impl LeafSink) -> WideLayout {
+        let mut nodes = vec![WideNode::EMPTY_NODE];
+        let mut depth = 1;
+        // Working lists kept from node to node (a build converts tens of thousands of nodes).
+        let (mut prims, mut pending) = (Vec::new(), Vec::new());
+        let mut slots: Vec<Part> = Vec::with_capacity(WIDTH);
+        // (wide node to fill, the part it stands for, its level from 1)
+        let mut stack: Vec<(usize, Part, u32)> = vec![(0, part, 1)];
+        while let Some((here, part, level)) = stack.pop() {
+            depth = depth.max(level);
+            self.fill_slots(part, &mut slots);
+            let mut node = WideNode::EMPTY_NODE;
+            for (slot, p) in slots.iter().enumerate() {
+                let bounds = self.bounds_of(p);
+                if self.terminal(p) {
+                    let (first, items) = self.leaf(p, sink, &mut prims, &mut pending);
+                    node.set_child(slot, &bounds, LEAF | first, items);
+                } else {
+                    let child = nodes.len();
+                    nodes.push(WideNode::EMPTY_NODE);
+                    node.set_child(slot, &bounds, child as u32, 0);
+                    stack.push((child, *p, level + 1));
+                }
+            }
+            nodes[here] = node;
+        }
+        WideLayout { nodes, depth }
+    }
 }
 
 /// Appends the primitives under `part` to `out`, in the binary tree's leaf order (`stack` is
@@ -274,8 +311,7 @@ mod tests {
     use glam::Vec3;
 
     use super::*;
-    use crate::accel::bvh::{BinnedSah, BuildKind, BuildNode, BuildTree};
-    use crate::accel::wide::node::{EMPTY, index_of, is_leaf};
+    use crate::accel::bvh::{BinnedSah, BuildKind, BuildNode, BuildTree, Bvh};
 
     /// Stores primitive references, at most `max` per leaf.
     struct Refs {
@@ -291,6 +327,14 @@ mod tests {
             let first = self.refs.len() as u32;
             self.refs.extend_from_slice(prims);
             (first, prims.len() as u8)
+        }
+        fn split(&self) -> Self {
+            Refs { max: self.max, refs: Vec::new() }
+        }
+        fn join(&mut self, other: Self) -> u32 {
+            let first = self.refs.len() as u32;
+            self.refs.extend(other.refs);
+            first
         }
     }
 
@@ -394,6 +438,47 @@ mod tests {
         let mut direct = Refs { max: 8, refs: Vec::new() };
         assert_eq!(convert(&tree, ConvertOptions { collapse: 0 }, &mut direct), layout);
         assert_eq!(direct.refs, sink.refs);
+    }
+
+    /// Each leaf's primitives, sorted, from the root down in slot order: the tree's shape,
+    /// whatever order its nodes and items are stored in.
+    fn shape(layout: &WideLayout, refs: &[u32]) -> Vec<Vec<u32>> {
+        let mut leaves = Vec::new();
+        let mut stack = vec![0u32];
+        while let Some(i) = stack.pop() {
+            let node = &layout.nodes[i as usize];
+            for slot in (0..WIDTH).rev().filter(|&s| node.children[s] != EMPTY) {
+                let c = node.children[slot];
+                if is_leaf(c) {
+                    let first = index_of(c) as usize;
+                    let mut prims = refs[first..first + node.counts[slot] as usize].to_vec();
+                    prims.sort_unstable();
+                    leaves.push(prims);
+                } else {
+                    stack.push(c);
+                }
+            }
+        }
+        leaves
+    }
+
+    #[test]
+    fn large_trees_convert_their_subtrees_in_parallel_into_the_same_tree() {
+        let n = 3 * PARALLEL_MIN as usize;
+        let boxes = grid(n);
+        let tree = BinnedSah::default().build_tree(&boxes);
+        for collapse in [0, 4] {
+            let options = ConvertOptions { collapse };
+            let mut sink = Refs { max: 8, refs: Vec::new() };
+            let layout = convert(&tree, options, &mut sink);
+            assert_eq!(check(&layout, &sink.refs, &boxes), layout.depth);
+            // One walk over the whole tree: the same nodes, depth and leaves.
+            let mut alone = Refs { max: 8, refs: Vec::new() };
+            let walked = Walker::new(&tree, options, 8).walk(Part::Node(tree.root), &mut alone);
+            assert_eq!((layout.nodes.len(), layout.depth), (walked.nodes.len(), walked.depth));
+            assert_eq!(shape(&layout, &sink.refs), shape(&walked, &alone.refs));
+            assert!(layout.nodes[0].children.iter().filter(|&&c| c != EMPTY && !is_leaf(c)).count() > 1);
+        }
     }
 
     #[test]

@@ -14,7 +14,8 @@
 //! Files:
 //!
 //! * [`node`]: the 256-byte node, child references, the scalar reference slab test.
-//! * [`convert`](mod@convert): binary tree to wide nodes (largest boxes pulled up first).
+//! * [`convert`](mod@convert): binary tree ([`binary`]: either kind the builders give) to wide
+//!   nodes (largest boxes pulled up first, subtrees in parallel).
 //! * [`isa`]: the instruction sets, detected at run time; [`kernels`]: the slab test of eight
 //!   children for each; `dispatch` (inside the crate): the per-query choice.
 //! * [`traverse`]: the single-ray traversal, generic over kernels and leaves; [`packet`]: the
@@ -29,6 +30,7 @@
 //!   to rebuild instead.
 //! * [`validate`]: the invariants of both, checked.
 
+pub mod binary;
 pub mod box_query;
 pub mod convert;
 // The per-query choice of compiled kernels: safe to call only with a structure's own nodes and
@@ -86,6 +88,16 @@ impl LeafSink for References {
         let first = self.0.len() as u32;
         self.0.extend_from_slice(prims);
         (first, prims.len() as u8)
+    }
+
+    fn split(&self) -> Self {
+        References(Vec::new())
+    }
+
+    fn join(&mut self, other: Self) -> u32 {
+        let first = self.0.len() as u32;
+        self.0.extend(other.0);
+        first
     }
 }
 

@@ -118,6 +118,16 @@ impl LeafSink for Blocks<'_> {
         }
         (first, (self.blocks.len() as u32 - first) as u8)
     }
+
+    fn split(&self) -> Self {
+        Blocks { ids: self.ids, blocks: Vec::new(), leaf_ids: Vec::new() }
+    }
+
+    fn join(&mut self, other: Self) -> u32 {
+        let first = self.blocks.len() as u32;
+        self.blocks.extend(other.blocks);
+        first
+    }
 }
 
 impl Blocks<'_> {
