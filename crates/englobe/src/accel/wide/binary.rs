@@ -1,4 +1,4 @@
-//! The binary trees the conversion to wide nodes reads ([`super::convert`]): the laid-out
+//! The binary trees the conversion to wide nodes reads ([`super::convert()`]): the laid-out
 //! [`Bvh`] of any builder, and the top-down builders' [`BuildTree`] as the build leaves it, so that
 //! a structure that keeps only the wide form skips the binary layout pass.
 

@@ -1,4 +1,4 @@
-//! From the canonical binary [`Bvh`] to wide nodes.
+//! From a binary tree (the canonical [`crate::accel::bvh::Bvh`], or a builder's tree) to wide nodes.
 //!
 //! Each wide node takes the place of a binary node and of as many of its descendants as fit in
 //! eight slots: starting from the node's two children, the child with the largest surface area is
