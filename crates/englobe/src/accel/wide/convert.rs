@@ -478,6 +478,10 @@ mod tests {
             assert_eq!((layout.nodes.len(), layout.depth), (walked.nodes.len(), walked.depth));
             assert_eq!(shape(&layout, &sink.refs), shape(&walked, &alone.refs));
             assert!(layout.nodes[0].children.iter().filter(|&&c| c != EMPTY && !is_leaf(c)).count() > 1);
+            // Parents before children, as the refit's single reverse pass needs.
+            for (i, node) in layout.nodes.iter().enumerate() {
+                assert!(node.children.iter().all(|&c| c == EMPTY || is_leaf(c) || c as usize > i), "node {i}");
+            }
         }
     }
 

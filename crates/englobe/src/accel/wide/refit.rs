@@ -11,7 +11,8 @@
 //! at a fixed ratio; Embree leaves it to the caller too).
 //!
 //! The wide nodes are stored parents before children (the conversion appends a node's children
-//! after it), so one pass over the nodes in reverse order sees every child before its parent.
+//! after it, and the subtrees it converts in parallel after the root), so one pass over the nodes
+//! in reverse order sees every child before its parent.
 //!
 //! The structure leaves out triangles that can never be hit (zero area, non-finite corners). If
 //! a stored triangle becomes one of them, or a left-out one stops being one, the leaves no longer
