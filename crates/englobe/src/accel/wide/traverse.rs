@@ -12,7 +12,8 @@
 //! all meets; its near boxes hold the small geometry around its origin, which it mostly passes by.
 //! Measured against nearest first (the example `triangle_bvh_stats`, and the renderer's `--stats`),
 //! it visits 28 % fewer nodes on random rays in the Sponza, 16 % fewer on its shadow rays, and
-//! never more on the other meshes and scenes (see `docs/performance.md`).
+//! never more on the other meshes and scenes (see `docs/performance.md`). The binary traversal
+//! has long used the same rule ([`crate::accel::bvh::ordered`]); the wide one had not.
 //!
 //! The traversal is generic over the node test ([`NodeKernel`], one per instruction set) and over
 //! what leaves hold ([`Leaves`]: primitive references tested by a closure, or blocks of
