@@ -58,22 +58,18 @@ fn main() -> anyhow::Result<()> {
             })
             .collect();
         let n = rays.len() as f64;
-        let mut c = WorkCounts::default();
-        let hits = rays.iter().filter(|ray| bvh.closest_hit(ray, &mut c).is_some()).count();
-        println!(
-            "  random rays, closest hit: {:.1} wide nodes and {:.1} triangles tested per ray ({:.1} % hit)",
-            c.nodes_visited as f64 / n,
-            c.exact_tests as f64 / n,
-            100.0 * hits as f64 / n
-        );
-        let mut c = WorkCounts::default();
-        let hits = rays.iter().filter(|ray| bvh.any_hit(ray, &mut c)).count();
-        println!(
-            "  the same rays, any hit: {:.1} wide nodes and {:.1} triangles tested per ray ({:.1} % hit)",
-            c.nodes_visited as f64 / n,
-            c.exact_tests as f64 / n,
-            100.0 * hits as f64 / n
-        );
+        let report = |query: &str, hit: &dyn Fn(&Ray, &mut WorkCounts) -> bool| {
+            let mut c = WorkCounts::default();
+            let hits = rays.iter().filter(|ray| hit(ray, &mut c)).count();
+            println!(
+                "  {query}: {:.1} wide nodes and {:.1} triangles tested per ray ({:.1} % hit)",
+                c.nodes_visited as f64 / n,
+                c.exact_tests as f64 / n,
+                100.0 * hits as f64 / n
+            );
+        };
+        report("random rays, closest hit", &|ray, c| bvh.closest_hit(ray, c).is_some());
+        report("the same rays, any hit", &|ray, c| bvh.any_hit(ray, c));
     }
     Ok(())
 }

@@ -96,19 +96,13 @@ where
     if walker.count[root as usize] < PARALLEL_MIN {
         return walker.walk(Part::Node(root), sink);
     }
-    let mut slots = Vec::with_capacity(WIDTH);
-    walker.fill_slots(Part::Node(root), &mut slots);
-    let mut node = WideNode::EMPTY_NODE;
-    let (mut prims, mut pending) = (Vec::new(), Vec::new());
+    let mut scratch = Scratch::default();
+    // The root's interior children are placed once their subtrees are converted.
     let mut subtrees = Vec::new();
-    for (slot, p) in slots.iter().enumerate() {
-        if walker.terminal(p) {
-            let (first, items) = walker.leaf(p, sink, &mut prims, &mut pending);
-            node.set_child(slot, &walker.bounds_of(p), LEAF | first, items);
-        } else {
-            subtrees.push((slot, *p));
-        }
-    }
+    let mut node = walker.node(Part::Node(root), sink, &mut scratch, |slot, p| {
+        subtrees.push((slot, p));
+        0
+    });
     let mut converted: Vec<Option<(WideLayout, S)>> = subtrees.iter().map(|_| None).collect();
     let template = &*sink;
     fill_indexed(&mut converted, 1, |i| {
@@ -117,11 +111,11 @@ where
     });
     let mut nodes = vec![WideNode::EMPTY_NODE];
     let mut depth = 1;
-    for (&(slot, p), done) in subtrees.iter().zip(converted) {
+    for (&(slot, _), done) in subtrees.iter().zip(converted) {
         let (layout, items) = done.expect("every subtree is converted");
         let first_node = nodes.len() as u32;
         let first_item = sink.join(items);
-        node.set_child(slot, &walker.bounds_of(&p), first_node, 0);
+        node.children[slot] = first_node;
         nodes.extend(layout.nodes.into_iter().map(|n| relocate(n, first_node, first_item)));
         depth = depth.max(1 + layout.depth);
     }
@@ -247,42 +241,57 @@ impl<'a, T: BinaryTree> Walker<'a, T> {
         }
     }
 
-    /// Stores the leaf part `p` through `sink` (`prims` and `pending` are working memory).
-    fn leaf(&self, p: &Part, sink: &mut impl LeafSink, prims: &mut Vec<u32>, pending: &mut Vec<u32>) -> (u32, u8) {
-        prims.clear();
-        gather(self.tree, p, prims, pending);
-        sink.leaf(prims)
+    /// The wide node standing for `part`: its leaf children stored through `sink`, its interior
+    /// children given the references `interior(slot, part)` returns.
+    fn node(
+        &self,
+        part: Part,
+        sink: &mut impl LeafSink,
+        scratch: &mut Scratch,
+        mut interior: impl FnMut(usize, Part) -> u32,
+    ) -> WideNode {
+        self.fill_slots(part, &mut scratch.slots);
+        let mut node = WideNode::EMPTY_NODE;
+        for (slot, p) in scratch.slots.iter().enumerate() {
+            let bounds = self.bounds_of(p);
+            if self.terminal(p) {
+                scratch.prims.clear();
+                gather(self.tree, p, &mut scratch.prims, &mut scratch.pending);
+                let (first, items) = sink.leaf(&scratch.prims);
+                node.set_child(slot, &bounds, LEAF | first, items);
+            } else {
+                node.set_child(slot, &bounds, interior(slot, *p), 0);
+            }
+        }
+        node
     }
 
     /// The wide subtree standing for `part` (its root is node 0), in one walk.
     fn walk(&self, part: Part, sink: &mut impl LeafSink) -> WideLayout {
         let mut nodes = vec![WideNode::EMPTY_NODE];
         let mut depth = 1;
-        // Working lists kept from node to node (a build converts tens of thousands of nodes).
-        let (mut prims, mut pending) = (Vec::new(), Vec::new());
-        let mut slots: Vec<Part> = Vec::with_capacity(WIDTH);
+        let mut scratch = Scratch::default();
         // (wide node to fill, the part it stands for, its level from 1)
         let mut stack: Vec<(usize, Part, u32)> = vec![(0, part, 1)];
         while let Some((here, part, level)) = stack.pop() {
             depth = depth.max(level);
-            self.fill_slots(part, &mut slots);
-            let mut node = WideNode::EMPTY_NODE;
-            for (slot, p) in slots.iter().enumerate() {
-                let bounds = self.bounds_of(p);
-                if self.terminal(p) {
-                    let (first, items) = self.leaf(p, sink, &mut prims, &mut pending);
-                    node.set_child(slot, &bounds, LEAF | first, items);
-                } else {
-                    let child = nodes.len();
-                    nodes.push(WideNode::EMPTY_NODE);
-                    node.set_child(slot, &bounds, child as u32, 0);
-                    stack.push((child, *p, level + 1));
-                }
-            }
-            nodes[here] = node;
+            nodes[here] = self.node(part, sink, &mut scratch, |_, p| {
+                let child = nodes.len();
+                nodes.push(WideNode::EMPTY_NODE);
+                stack.push((child, p, level + 1));
+                child as u32
+            });
         }
         WideLayout { nodes, depth }
     }
+}
+
+/// Working lists kept from node to node (a build converts tens of thousands of nodes).
+#[derive(Default)]
+struct Scratch {
+    slots: Vec<Part>,
+    prims: Vec<u32>,
+    pending: Vec<u32>,
 }
 
 /// Appends the primitives under `part` to `out`, in the binary tree's leaf order (`stack` is

@@ -235,9 +235,7 @@ impl Splitter for BinnedSah {
             }
         }
 
-        let splittable = scale.map(|s| s > 0.0);
-        let best = best_plane(bins, k, splittable);
-        let (weighted, axis, plane) = best?;
+        let (weighted, axis, plane) = best_plane(bins, k, scale.map(|s| s > 0.0))?;
         if !must_split && !split_beats_leaf(weighted, bounds.surface_area(), refs.len()) {
             return None;
         }
