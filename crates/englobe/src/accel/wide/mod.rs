@@ -158,8 +158,14 @@ struct ClosureLeaves<'a, F> {
 }
 
 impl<C: Counters, F: FnMut(u32, &Ray) -> Option<PrimHit>> Leaves<C> for ClosureLeaves<'_, F> {
+    /// Nothing: the closure tests the ray itself.
+    type Prepared = ();
+
     #[inline(always)]
-    fn closest(&mut self, first: u32, count: u32, counters: &mut C) {
+    fn prepare(&self) {}
+
+    #[inline(always)]
+    fn closest(&mut self, _: &(), first: u32, count: u32, counters: &mut C) {
         for &prim in &self.prims[first as usize..(first + count) as usize] {
             counters.exact_test();
             if let Some(hit) = (self.test)(prim, &self.record.ray) {
@@ -174,7 +180,7 @@ impl<C: Counters, F: FnMut(u32, &Ray) -> Option<PrimHit>> Leaves<C> for ClosureL
     }
 
     #[inline(always)]
-    fn any(&mut self, first: u32, count: u32, counters: &mut C) -> bool {
+    fn any(&mut self, _: &(), first: u32, count: u32, counters: &mut C) -> bool {
         for &prim in &self.prims[first as usize..(first + count) as usize] {
             counters.exact_test();
             if (self.test)(prim, &self.record.ray).is_some() {

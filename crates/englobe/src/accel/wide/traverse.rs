@@ -48,12 +48,19 @@ pub struct Entry {
 
 /// What the leaves of a wide BVH hold, and how a query tests them.
 pub trait Leaves<C: Counters> {
+    /// What a query prepares for its leaf tests (the triangle test's constants of its ray), once,
+    /// at the first leaf it reaches: a ray that reaches none never pays for it. The walk keeps it
+    /// in its own frame rather than in the leaves, which the compiler would otherwise copy in and
+    /// out at every query, prepared or not.
+    type Prepared;
+    /// Prepares the leaf tests of this query.
+    fn prepare(&self) -> Self::Prepared;
     /// Tests the `count` items from `first` for the closest hit, shrinking the interval.
-    fn closest(&mut self, first: u32, count: u32, counters: &mut C);
+    fn closest(&mut self, prepared: &Self::Prepared, first: u32, count: u32, counters: &mut C);
     /// The end of the interval: the closest hit so far, or the ray's `t_max`.
     fn t_max(&self) -> f32;
     /// Whether any of the `count` items from `first` is hit.
-    fn any(&mut self, first: u32, count: u32, counters: &mut C) -> bool;
+    fn any(&mut self, prepared: &Self::Prepared, first: u32, count: u32, counters: &mut C) -> bool;
     /// Starts loading the first item from `first` into the cache (a hint; nothing by default).
     #[inline(always)]
     fn prefetch(&self, first: u32) {
@@ -124,6 +131,18 @@ fn give_back(deep: Vec<MaybeUninit<Entry>>) {
     }
 }
 
+/// The leaves' prepared state, made now if this is the query's first leaf.
+///
+/// Not `Option::get_or_insert_with`, for the reason given at [`stack_for`].
+#[inline(always)]
+fn prepare_once<'p, C: Counters, L: Leaves<C>>(slot: &'p mut Option<L::Prepared>, leaves: &L) -> &'p L::Prepared {
+    if slot.is_none() {
+        *slot = Some(leaves.prepare());
+    }
+    // SAFETY: set just above if it was not.
+    unsafe { slot.as_ref().unwrap_unchecked() }
+}
+
 /// The closest hit: walks the tree from node `start` (0, the root, for a whole query), asking
 /// `leaves` to test the leaves the ray reaches, nearest first.
 ///
@@ -147,10 +166,12 @@ pub unsafe fn closest<K: NodeKernel, C: Counters, L: Leaves<C>>(
     let mut len = 0usize;
     let mut dist = [0.0f32; WIDTH];
     let mut current = Entry { reference: start, count: 0, t: 0.0 };
+    let mut prepared_slot = None;
     'walk: loop {
         {
             if is_leaf(current.reference) {
-                leaves.closest(index_of(current.reference), current.count, counters);
+                let prepared = prepare_once(&mut prepared_slot, leaves);
+                leaves.closest(prepared, index_of(current.reference), current.count, counters);
             } else {
                 debug_assert!((current.reference as usize) < nodes.len());
                 // SAFETY: the caller's guarantee: interior references index `nodes`.
@@ -251,10 +272,12 @@ pub unsafe fn any<K: NodeKernel, C: Counters, L: Leaves<C>>(
     let mut len = 0usize;
     let mut dist = [0.0f32; WIDTH];
     let mut current = Entry { reference: start, count: 0, t: 0.0 };
+    let mut prepared_slot = None;
     let hit = 'walk: loop {
         {
             if is_leaf(current.reference) {
-                if leaves.any(index_of(current.reference), current.count, counters) {
+                let prepared = prepare_once(&mut prepared_slot, leaves);
+                if leaves.any(prepared, index_of(current.reference), current.count, counters) {
                     break 'walk true;
                 }
             } else {

@@ -311,8 +311,7 @@ impl TriangleBvh {
         if !may_enter(&self.bounds, ray, reach(ray.t_max)) {
             return None;
         }
-        let mut leaves =
-            TriangleLeaves { blocks: &self.blocks, source: ray, ray: None, best: None, t_max: ray.t_max, filter };
+        let mut leaves = TriangleLeaves { blocks: &self.blocks, source: ray, best: None, t_max: ray.t_max, filter };
         dispatch::closest(self.isa, &self.nodes, self.depth, 0, &NodeRay::new(ray), &mut leaves, counters);
         leaves.best
     }
@@ -340,8 +339,7 @@ impl TriangleBvh {
         if !may_enter(&self.bounds, ray, reach(ray.t_max)) {
             return false;
         }
-        let mut leaves =
-            TriangleLeaves { blocks: &self.blocks, source: ray, ray: None, best: None, t_max: ray.t_max, filter };
+        let mut leaves = TriangleLeaves { blocks: &self.blocks, source: ray, best: None, t_max: ray.t_max, filter };
         dispatch::any(self.isa, &self.nodes, self.depth, 0, &NodeRay::new(ray), reach(ray.t_max), &mut leaves, counters)
     }
 
@@ -382,9 +380,6 @@ impl TriangleBvh {
 pub(super) struct TriangleLeaves<'a, F> {
     pub(super) blocks: &'a [TriBlock],
     pub(super) source: &'a Ray,
-    /// The triangle test's constants, prepared at the first leaf: a ray that reaches none (one
-    /// that misses the mesh's box, say) never pays for them.
-    pub(super) ray: Option<TriRay>,
     pub(super) best: Option<Hit>,
     pub(super) t_max: f32,
     pub(super) filter: F,
@@ -406,10 +401,17 @@ fn offer<F: HitFilter<Hit>>(best: &mut Option<Hit>, t_max: &mut f32, filter: &mu
 }
 
 impl<C: Counters, F: HitFilter<Hit>> Leaves<C> for TriangleLeaves<'_, F> {
+    /// The triangle test's constants of the ray.
+    type Prepared = TriRay;
+
     #[inline(always)]
-    fn closest(&mut self, first: u32, count: u32, counters: &mut C) {
+    fn prepare(&self) -> TriRay {
+        TriRay::new(self.source)
+    }
+
+    #[inline(always)]
+    fn closest(&mut self, ray: &TriRay, first: u32, count: u32, counters: &mut C) {
         let source = self.source;
-        let ray = self.ray.get_or_insert_with(|| TriRay::new(source));
         for block in &self.blocks[first as usize..(first + count) as usize] {
             for _ in 0..block.used() {
                 counters.exact_test();
@@ -452,9 +454,8 @@ impl<C: Counters, F: HitFilter<Hit>> Leaves<C> for TriangleLeaves<'_, F> {
     }
 
     #[inline(always)]
-    fn any(&mut self, first: u32, count: u32, counters: &mut C) -> bool {
+    fn any(&mut self, ray: &TriRay, first: u32, count: u32, counters: &mut C) -> bool {
         let source = self.source;
-        let ray = self.ray.get_or_insert_with(|| TriRay::new(source));
         for block in &self.blocks[first as usize..(first + count) as usize] {
             for _ in 0..block.used() {
                 counters.exact_test();

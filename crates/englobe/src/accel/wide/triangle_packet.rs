@@ -65,7 +65,7 @@ impl<'a> TrianglePacket<'a> {
     fn lane(&self, i: usize) -> TriangleLeaves<'a, NoFilter> {
         let source = &self.rays[i.min(self.rays.len() - 1)];
         let blocks = self.bvh.blocks();
-        TriangleLeaves { blocks, source, ray: None, best: None, t_max: self.best.t.0[i], filter: NoFilter }
+        TriangleLeaves { blocks, source, best: None, t_max: self.best.t.0[i], filter: NoFilter }
     }
 
     /// The closest hit of ray `i`.
@@ -147,7 +147,8 @@ impl<C: Counters> PacketLeaves<C> for TrianglePacket<'_> {
             let i = rays.trailing_zeros() as usize;
             rays &= rays - 1;
             let mut lane = self.lane(i);
-            Leaves::<C>::closest(&mut lane, first, count, counters);
+            let ray = Leaves::<C>::prepare(&lane);
+            Leaves::<C>::closest(&mut lane, &ray, first, count, counters);
             if let Some(hit) = lane.best {
                 self.offer(i, hit);
             }
@@ -165,7 +166,9 @@ impl<C: Counters> PacketLeaves<C> for TrianglePacket<'_> {
         while rays != 0 {
             let i = rays.trailing_zeros() as usize;
             rays &= rays - 1;
-            if Leaves::<C>::any(&mut self.lane(i), first, count, counters) {
+            let mut lane = self.lane(i);
+            let ray = Leaves::<C>::prepare(&lane);
+            if Leaves::<C>::any(&mut lane, &ray, first, count, counters) {
                 found |= 1 << i;
             }
         }
