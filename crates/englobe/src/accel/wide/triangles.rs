@@ -79,12 +79,17 @@ pub fn is_storable(v: &[Vec3; 3]) -> bool {
 }
 
 /// A ray prepared for block tests: the watertight test's constants, and what the box-stretch
-/// correction of a hit needs. The ray itself is not copied in: the rare special lanes get it from
-/// the caller (see [`TriRay::scalar`]).
+/// correction of a hit needs, all in the ray's axis order `kx, ky, kz`, so that a block test
+/// indexes nothing but the block's rows. The ray itself is not copied in: the rare special lanes
+/// get it from the caller (see [`TriRay::scalar`]).
 #[derive(Clone, Copy, Debug)]
 pub struct TriRay {
+    /// The origin's coordinates along `kx, ky, kz`.
     origin: [Vec4; 3],
+    /// The inverse direction's components along `kx, ky, kz`.
     inv_dir: [Vec4; 3],
+    /// The axes `kx, ky, kz`: each below 3 (an invariant of [`TriRay::new`], which
+    /// [`TriRay::row`] relies on to read a block without a bounds check).
     axes: [usize; 3],
     shear: [Vec4; 3],
     t_min: Vec4,
@@ -96,13 +101,25 @@ impl TriRay {
     pub fn new(ray: &Ray) -> Self {
         let watertight = WatertightRay::new(ray);
         let (o, inv, s) = (ray.origin(), ray.inv_dir(), watertight.shear());
+        let axes = watertight.axes();
         TriRay {
-            origin: [0, 1, 2].map(|a| Vec4::splat(o[a])),
-            inv_dir: [0, 1, 2].map(|a| Vec4::splat(inv[a])),
-            axes: watertight.axes(),
+            origin: axes.map(|a| Vec4::splat(o[a])),
+            inv_dir: axes.map(|a| Vec4::splat(inv[a])),
+            axes,
             shear: [0, 1, 2].map(|a| Vec4::splat(s[a])),
             t_min: Vec4::splat(ray.t_min),
         }
+    }
+
+    /// Row `axis` (0, 1, 2 for `kx, ky, kz`) of vertex `k` of `block`: that coordinate of the
+    /// vertex for each lane.
+    #[inline(always)]
+    fn row(&self, block: &TriBlock, k: usize, axis: usize) -> Vec4 {
+        let index = 3 * k + self.axes[axis];
+        debug_assert!(k < 3 && self.axes[axis] < 3);
+        // SAFETY: `k < 3` at every call (a literal), and the axes are below 3 (see `axes`), so
+        // the index is below the block's nine rows.
+        Vec4::from_array(*unsafe { block.v.get_unchecked(index) })
     }
 
     /// The scalar test of lane `lane` with the interval `ray.t_min..=t_max`, `ray` being the ray
@@ -135,15 +152,26 @@ impl BlockHits {
     pub const NONE: BlockHits = BlockHits { hit: 0, special: 0, t: [0.0; 4], u: [0.0; 4], v: [0.0; 4] };
 }
 
-/// `if a > b { a } else { b }` per lane, as the scalar slab test: `b` when `a` is NaN.
+/// `if a > b { a } else { b }` per lane, as the scalar slab test: `b` when `a` is NaN, and when
+/// both are zeros. On x86-64 this is exactly what `maxps` computes (Intel's definition: the
+/// second operand unless the first is greater), one instruction instead of a compare and a blend.
+/// Not glam's `Vec4::max`, whose NaN behaviour is left to each architecture.
 #[inline(always)]
 fn keep_greater(a: Vec4, b: Vec4) -> Vec4 {
+    // SAFETY: SSE is part of every x86-64 processor.
+    #[cfg(target_arch = "x86_64")]
+    return unsafe { std::arch::x86_64::_mm_max_ps(a.into(), b.into()) }.into();
+    #[cfg(not(target_arch = "x86_64"))]
     Vec4::select(a.cmpgt(b), a, b)
 }
 
-/// `if a < b { a } else { b }` per lane.
+/// `if a < b { a } else { b }` per lane: `minps` on x86-64, as [`keep_greater`] is `maxps`.
 #[inline(always)]
 fn keep_less(a: Vec4, b: Vec4) -> Vec4 {
+    // SAFETY: as in `keep_greater`.
+    #[cfg(target_arch = "x86_64")]
+    return unsafe { std::arch::x86_64::_mm_min_ps(a.into(), b.into()) }.into();
+    #[cfg(not(target_arch = "x86_64"))]
     Vec4::select(a.cmplt(b), a, b)
 }
 
@@ -158,12 +186,11 @@ fn normal(x: Vec4) -> BVec4A {
 /// `t_min..=t_max`. Every lane reports what [`intersect_triangle`] would, or is special.
 #[inline(always)]
 pub fn intersect_block(block: &TriBlock, r: &TriRay, t_max: f32) -> BlockHits {
-    let [kx, ky, kz] = r.axes;
-    let row = |k: usize, axis: usize| Vec4::from_array(block.v[3 * k + axis]);
     let [sx, sy, sz] = r.shear;
     // Vertex k relative to the origin, sheared: exactly the scalar test's `ax`, `ay`, `az`.
     let project = |k: usize| {
-        let (x, y, z) = (row(k, kx) - r.origin[kx], row(k, ky) - r.origin[ky], row(k, kz) - r.origin[kz]);
+        let (x, y, z) =
+            (r.row(block, k, 0) - r.origin[0], r.row(block, k, 1) - r.origin[1], r.row(block, k, 2) - r.origin[2]);
         (x - sx * z, y - sy * z, z)
     };
     let (ax, ay, a_z) = project(0);
@@ -195,10 +222,13 @@ pub fn intersect_block(block: &TriBlock, r: &TriRay, t_max: f32) -> BlockHits {
     let candidate = candidate & finite;
 
     // The box-stretch correction of the scalar test's `finish`: the stretch of the whole line
-    // inside the triangle's box, computed as the robust slab test computes it.
+    // inside the triangle's box, computed as the robust slab test computes it. The axes are taken
+    // in the order `kx, ky, kz` rather than `x, y, z`: the largest entry and the smallest exit do not
+    // depend on the order (a NaN distance is skipped wherever it comes; only the sign of a zero
+    // could differ, and it compares equal), and the rows are the ones the projection read.
     let (mut enter, mut exit) = (Vec4::NEG_INFINITY, Vec4::INFINITY);
     for axis in 0..3 {
-        let (p, q, s) = (row(0, axis), row(1, axis), row(2, axis));
+        let (p, q, s) = (r.row(block, 0, axis), r.row(block, 1, axis), r.row(block, 2, axis));
         let (lo, hi) = (p.min(q).min(s), p.max(q).max(s));
         let inv = r.inv_dir[axis];
         let positive_dir = inv.cmpge(zero);
@@ -210,8 +240,9 @@ pub fn intersect_block(block: &TriBlock, r: &TriRay, t_max: f32) -> BlockHits {
         exit = keep_less(t_far, exit);
     }
     let in_box = enter.cmple(exit);
-    let t = Vec4::select(t.cmplt(enter), enter, t);
-    let t = Vec4::select(t.cmpgt(exit), exit, t);
+    // `if t < enter { enter } else { t }`, then `if t > exit { exit } else { t }`.
+    let t = keep_greater(enter, t);
+    let t = keep_less(exit, t);
     let in_range = t.cmpge(r.t_min) & t.cmple(Vec4::splat(t_max));
     let hit = candidate & in_box & in_range;
     BlockHits {
