@@ -61,6 +61,8 @@ impl WatertightRay {
     pub fn new(ray: &Ray) -> Self {
         let d = ray.dir();
         let [kx, ky, kz] = Self::axes_of(d);
+        // An array, not the vector: `Vec3`'s index is a chain of comparisons per lookup.
+        let d = d.to_array();
         let shear = Vec3::new(d[kx] / d[kz], d[ky] / d[kz], 1.0 / d[kz]);
         WatertightRay { kx, ky, kz, shear }
     }

@@ -100,7 +100,8 @@ impl TriRay {
     #[inline(always)]
     pub fn new(ray: &Ray) -> Self {
         let watertight = WatertightRay::new(ray);
-        let (o, inv, s) = (ray.origin(), ray.inv_dir(), watertight.shear());
+        // Arrays, not vectors: `Vec3`'s index is a chain of comparisons per lookup.
+        let (o, inv, s) = (ray.origin().to_array(), ray.inv_dir().to_array(), watertight.shear());
         let axes = watertight.axes();
         TriRay {
             origin: axes.map(|a| Vec4::splat(o[a])),
