@@ -8,8 +8,9 @@
 //! rows of the block are read, so no data moves per ray.
 //!
 //! The lanes compute exactly what the scalar test [`intersect_triangle`] computes, with the same
-//! operations in the same order (no fused multiply-add), so a lane hits if and only if the scalar
-//! test hits, at the same `t`. The scalar test's rare paths are not duplicated: a lane whose edge
+//! operations in the same order (no fused multiply-add; only the box-stretch correction takes its
+//! three axes in another order, which cannot change its result, see [`intersect_block`]), so a
+//! lane hits if and only if the scalar test hits, at the same `t`. The scalar test's rare paths are not duplicated: a lane whose edge
 //! functions are not all normal numbers (zero, subnormal, infinite: a ray through an edge or a
 //! vertex, or a scene at an extreme scale) or whose `t` is not finite is reported as *special*,
 //! and the caller runs the scalar test on that triangle. Lanes whose edge functions have strictly
