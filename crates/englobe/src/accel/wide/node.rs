@@ -112,14 +112,17 @@ pub struct NodeRay {
     pub inv_far: [f32; 3],
     /// The ray's `t_min`.
     pub t_min: f32,
-    /// Byte offsets of the near and far rows of each axis in [`WideNode::bounds`], for kernels
-    /// that load rows without an index check. Private, so that only [`NodeRay::new`] makes them,
-    /// always below `ROWS * WIDTH * 4`.
-    row_bytes: [[u32; 2]; 3],
+    /// Byte offset of the near row of each axis in [`WideNode::bounds`], for kernels that load
+    /// rows without an index check; the far row is the axis's other one, at `near ^ ROW_BYTES`
+    /// (rows `2a` and `2a + 1` differ in that bit alone), so that a node test keeps three offsets
+    /// live rather than six. Private, so that only [`NodeRay::new`] makes them, always below
+    /// `ROWS * WIDTH * 4`.
+    row_bytes: [u32; 3],
 }
 
 /// Bytes of one row of [`WideNode::bounds`].
 const ROW_BYTES: u32 = (WIDTH * 4) as u32;
+const _: () = assert!(ROW_BYTES.is_power_of_two(), "the far row is found by flipping one bit");
 
 impl NodeRay {
     /// Prepares `ray`.
@@ -129,23 +132,26 @@ impl NodeRay {
         // Bit `a` set if the ray goes down axis `a` (`!(inv >= 0)`, as the scalar slab test
         // decides it; the inverse of a zero component is `+inf`, never `-inf`).
         let down = inv.cmplt(glam::Vec3::ZERO).bitmask();
-        let rows = |a: u32| {
-            let d = (down >> a) & 1;
-            [(2 * a + d) * ROW_BYTES, (2 * a + 1 - d) * ROW_BYTES]
-        };
+        let near = |a: u32| (2 * a + ((down >> a) & 1)) * ROW_BYTES;
         NodeRay {
             origin: ray.origin().to_array(),
             inv_dir: inv.to_array(),
             inv_far: (inv * ROBUST_FAR_SCALE).to_array(),
             t_min: ray.t_min,
-            row_bytes: [rows(0), rows(1), rows(2)],
+            row_bytes: [near(0), near(1), near(2)],
         }
+    }
+
+    /// Byte offset of the near (`side` 0) or far (`side` 1) row of `axis`.
+    #[inline(always)]
+    fn row_offset(&self, axis: usize, side: usize) -> u32 {
+        self.row_bytes[axis] ^ (side as u32 * ROW_BYTES)
     }
 
     /// Row of the near (`side` 0) or far (`side` 1) plane of `axis` in [`WideNode::bounds`].
     #[inline(always)]
     pub fn row_index(&self, axis: usize, side: usize) -> usize {
-        (self.row_bytes[axis][side] / ROW_BYTES) as usize
+        (self.row_offset(axis, side) / ROW_BYTES) as usize
     }
 }
 
@@ -154,7 +160,7 @@ impl NodeRay {
     #[inline(always)]
     pub fn row<'a>(&self, node: &'a WideNode, axis: usize, side: usize) -> &'a [f32; WIDTH] {
         debug_assert!(axis < 3 && side < 2);
-        let offset = self.row_bytes[axis][side] as usize;
+        let offset = self.row_offset(axis, side) as usize;
         // SAFETY: `NodeRay::new`, the only maker of `row_bytes`, gives each the start of a row of
         // `bounds` (row < ROWS), a multiple of a row's size; rows are arrays of WIDTH floats.
         unsafe { &*((node.bounds.as_ptr() as *const u8).add(offset) as *const [f32; WIDTH]) }
