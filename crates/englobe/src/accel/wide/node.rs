@@ -114,8 +114,8 @@ pub struct NodeRay {
     pub t_min: f32,
     /// Byte offset of the near row of each axis in [`WideNode::bounds`], for kernels that load
     /// rows without an index check; the far row is the axis's other one, at `near ^ ROW_BYTES`
-    /// (rows `2a` and `2a + 1` differ in that bit alone), so that a node test keeps three offsets
-    /// live rather than six. Private, so that only [`NodeRay::new`] makes them, always below
+    /// (rows `2a` and `2a + 1` differ in that bit alone), so that a query makes three offsets
+    /// rather than six. Private, so that only [`NodeRay::new`] makes them, always below
     /// `ROWS * WIDTH * 4`.
     row_bytes: [u32; 3],
 }
