@@ -142,10 +142,11 @@ impl NodeRay {
         }
     }
 
-    /// Byte offset of the near (`side` 0) or far (`side` 1) row of `axis`.
+    /// Byte offset of the near (`side` 0) or far (`side` 1) row of `axis` (only the lowest bit of
+    /// `side` counts, so that the offset stays within `bounds` whatever it is).
     #[inline(always)]
     fn row_offset(&self, axis: usize, side: usize) -> u32 {
-        self.row_bytes[axis] ^ (side as u32 * ROW_BYTES)
+        self.row_bytes[axis] ^ ((side as u32 & 1) * ROW_BYTES)
     }
 
     /// Row of the near (`side` 0) or far (`side` 1) plane of `axis` in [`WideNode::bounds`].
@@ -162,7 +163,8 @@ impl NodeRay {
         debug_assert!(axis < 3 && side < 2);
         let offset = self.row_offset(axis, side) as usize;
         // SAFETY: `NodeRay::new`, the only maker of `row_bytes`, gives each the start of a row of
-        // `bounds` (row < ROWS), a multiple of a row's size; rows are arrays of WIDTH floats.
+        // `bounds` (row < ROWS), a multiple of a row's size, and `row_offset` at most flips it to
+        // the other row of the same axis; rows are arrays of WIDTH floats.
         unsafe { &*((node.bounds.as_ptr() as *const u8).add(offset) as *const [f32; WIDTH]) }
     }
 }
