@@ -17,7 +17,7 @@
 # first. Valgrind cannot run AVX-512, so both englobe and Embree run their AVX2 kernels.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-[[ $# -ge 1 ]] || { sed -n '7,10p' "$0" >&2; exit 2; }
+[[ $# -ge 1 ]] || { sed -n '8,13s/^# \{0,1\}//p' "$0" >&2; exit 2; }
 mesh="$1"
 shift
 libraries="englobe"
