@@ -3,8 +3,8 @@
 //! without another test if a closer hit is found before they are popped. This is the traversal
 //! of Wald, Benthin and Boulos (2008), "Getting Rid of Packets: Efficient SIMD Single-Ray
 //! Traversal using Multi-branching BVHs", in the form Embree's `BVHNIntersector1` gives it (Wald
-//! et al. 2014): no sorting at all when one child or two are hit (the common cases), a short
-//! insertion sort of the hit children otherwise.
+//! et al. 2014): no sorting at all when one child or two are hit (the common cases), up to four
+//! sorted in registers by compare-and-swap, an insertion sort on the stack for the rest.
 //!
 //! Occlusion queries stop at the first occluder and do not sort: they enter the *farthest* child
 //! hit first and push the others as they come. A ray's far boxes are where the surfaces that close
@@ -143,6 +143,13 @@ fn prepare_once<'p, C: Counters, L: Leaves<C>>(slot: &'p mut Option<L::Prepared>
     unsafe { slot.as_ref().unwrap_unchecked() }
 }
 
+/// The two entries with the farther one first, as they go on the stack; a tie keeps them in
+/// their order (only a strictly nearer second entry is swapped), as an insertion sort does.
+#[inline(always)]
+fn farther_first(first: Entry, second: Entry) -> (Entry, Entry) {
+    if first.t < second.t { (second, first) } else { (first, second) }
+}
+
 /// The closest hit: walks the tree from node `start` (0, the root, for a whole query), asking
 /// `leaves` to test the leaves the ray reaches, nearest first.
 ///
@@ -200,12 +207,40 @@ pub unsafe fn closest<K: NodeKernel, C: Counters, L: Leaves<C>>(
                         current = near;
                         continue;
                     }
-                    // Three or more: push them all, sort the pushed ones farthest first (an
-                    // insertion sort of at most eight), and take the nearest off the top.
-                    let base = len;
+                    // Three or more: the first four sorted in registers, farthest first (the
+                    // order an insertion sort gives, ties kept in slot order); the rest, if any,
+                    // pushed above them and sorted in on the stack. The nearest is entered.
+                    let third = mask.trailing_zeros() as usize;
+                    mask &= mask - 1;
+                    let c = Entry { reference: node.children[third], count: node.counts[third] as u32, t: dist[third] };
+                    let (a, b) = farther_first(a, b);
+                    let (b, c) = farther_first(b, c);
+                    let (a, b) = farther_first(a, b);
+                    if mask == 0 {
+                        stack[len].write(a);
+                        stack[len + 1].write(b);
+                        len += 2;
+                        current = c;
+                        continue;
+                    }
+                    let fourth = mask.trailing_zeros() as usize;
+                    mask &= mask - 1;
+                    let d =
+                        Entry { reference: node.children[fourth], count: node.counts[fourth] as u32, t: dist[fourth] };
+                    let (c, d) = farther_first(c, d);
+                    let (b, c) = farther_first(b, c);
+                    let (a, b) = farther_first(a, b);
                     stack[len].write(a);
                     stack[len + 1].write(b);
-                    len += 2;
+                    stack[len + 2].write(c);
+                    if mask == 0 {
+                        len += 3;
+                        current = d;
+                        continue;
+                    }
+                    let base = len;
+                    stack[len + 3].write(d);
+                    len += 4;
                     while mask != 0 {
                         let i = mask.trailing_zeros() as usize;
                         mask &= mask - 1;
@@ -216,7 +251,7 @@ pub unsafe fn closest<K: NodeKernel, C: Counters, L: Leaves<C>>(
                         });
                         len += 1;
                     }
-                    for i in base + 1..len {
+                    for i in base + 4..len {
                         // SAFETY: entries below `len` were written.
                         let e = unsafe { stack[i].assume_init() };
                         let mut j = i;
