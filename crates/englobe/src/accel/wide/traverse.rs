@@ -69,14 +69,10 @@ pub trait Leaves<C: Counters> {
 }
 
 /// Asks for every child of `node` in `mask` (the ones a ray enters), so that their cache misses
-/// overlap instead of following one another as the walk reaches them. A lone child is not asked
-/// for: the walk reads it next, so there is nothing for its miss to overlap with.
-#[inline(always)]
-fn prefetch_children<C: Counters, L: Leaves<C>>(nodes: &[WideNode], node: &WideNode, mask: u32, leaves: &L) {
-    prefetch_children_of(nodes, node, mask, |first| leaves.prefetch(first));
-}
-
-/// [`prefetch_children`] with the leaves' prefetch given as `leaf` (for the packet traversal).
+/// overlap instead of following one another as the walk reaches them; `leaf` asks for a leaf's
+/// first item. A lone child is not asked for: the walk reads it next, so there is nothing for its
+/// miss to overlap with. (The single-ray walks ask for each child as they make its entry, in the
+/// loop over the mask they run anyway.)
 #[inline(always)]
 pub(super) fn prefetch_children_of(nodes: &[WideNode], node: &WideNode, mut mask: u32, leaf: impl Fn(u32)) {
     if mask & mask.wrapping_sub(1) == 0 {
@@ -85,13 +81,34 @@ pub(super) fn prefetch_children_of(nodes: &[WideNode], node: &WideNode, mut mask
     while mask != 0 {
         let i = mask.trailing_zeros() as usize;
         mask &= mask - 1;
-        let c = node.children[i];
-        if is_leaf(c) {
-            leaf(index_of(c));
-        } else {
-            prefetch(nodes, c);
-        }
+        prefetch_child(nodes, node.children[i], &leaf);
     }
+}
+
+/// Asks for one child: a node, or the first item of a leaf through `leaf`.
+#[inline(always)]
+fn prefetch_child(nodes: &[WideNode], child: u32, leaf: impl Fn(u32)) {
+    if is_leaf(child) {
+        leaf(index_of(child));
+    } else {
+        prefetch(nodes, child);
+    }
+}
+
+/// The entry of child `slot` of `node`, entered at `dist[slot]`, asked for (see
+/// [`prefetch_children_of`]) as it is made: [`closest`] makes one only when two children or more
+/// are entered, so that the loop over the mask is the one that makes the entries.
+#[inline(always)]
+fn asked_entry<C: Counters, L: Leaves<C>>(
+    nodes: &[WideNode],
+    node: &WideNode,
+    slot: usize,
+    dist: &[f32; WIDTH],
+    leaves: &L,
+) -> Entry {
+    let reference = node.children[slot];
+    prefetch_child(nodes, reference, |first| leaves.prefetch(first));
+    Entry { reference, count: node.counts[slot] as u32, t: dist[slot] }
 }
 
 thread_local! {
@@ -187,19 +204,19 @@ pub unsafe fn closest<K: NodeKernel, C: Counters, L: Leaves<C>>(
                 counters.box_tests(WIDTH as u32);
                 // SAFETY: the caller's guarantee.
                 let mut mask = unsafe { kernel.children(node, ray, reach(leaves.t_max()), &mut dist) };
-                prefetch_children(nodes, node, mask, leaves);
                 if mask != 0 {
                     let first = mask.trailing_zeros() as usize;
                     mask &= mask - 1;
-                    let a = Entry { reference: node.children[first], count: node.counts[first] as u32, t: dist[first] };
                     if mask == 0 {
-                        current = a;
+                        // A lone child is not asked for: it is read next.
+                        current =
+                            Entry { reference: node.children[first], count: node.counts[first] as u32, t: dist[first] };
                         continue;
                     }
+                    let a = asked_entry(nodes, node, first, &dist, leaves);
                     let second = mask.trailing_zeros() as usize;
                     mask &= mask - 1;
-                    let b =
-                        Entry { reference: node.children[second], count: node.counts[second] as u32, t: dist[second] };
+                    let b = asked_entry(nodes, node, second, &dist, leaves);
                     if mask == 0 {
                         let (near, far) = if b.t < a.t { (b, a) } else { (a, b) };
                         stack[len].write(far);
@@ -212,7 +229,7 @@ pub unsafe fn closest<K: NodeKernel, C: Counters, L: Leaves<C>>(
                     // pushed above them and sorted in on the stack. The nearest is entered.
                     let third = mask.trailing_zeros() as usize;
                     mask &= mask - 1;
-                    let c = Entry { reference: node.children[third], count: node.counts[third] as u32, t: dist[third] };
+                    let c = asked_entry(nodes, node, third, &dist, leaves);
                     let (a, b) = farther_first(a, b);
                     let (b, c) = farther_first(b, c);
                     let (a, b) = farther_first(a, b);
@@ -225,8 +242,7 @@ pub unsafe fn closest<K: NodeKernel, C: Counters, L: Leaves<C>>(
                     }
                     let fourth = mask.trailing_zeros() as usize;
                     mask &= mask - 1;
-                    let d =
-                        Entry { reference: node.children[fourth], count: node.counts[fourth] as u32, t: dist[fourth] };
+                    let d = asked_entry(nodes, node, fourth, &dist, leaves);
                     let (c, d) = farther_first(c, d);
                     let (b, c) = farther_first(b, c);
                     let (a, b) = farther_first(a, b);
@@ -244,11 +260,7 @@ pub unsafe fn closest<K: NodeKernel, C: Counters, L: Leaves<C>>(
                     while mask != 0 {
                         let i = mask.trailing_zeros() as usize;
                         mask &= mask - 1;
-                        stack[len].write(Entry {
-                            reference: node.children[i],
-                            count: node.counts[i] as u32,
-                            t: dist[i],
-                        });
+                        stack[len].write(asked_entry(nodes, node, i, &dist, leaves));
                         len += 1;
                     }
                     for i in base + 4..len {
@@ -323,15 +335,19 @@ pub unsafe fn any<K: NodeKernel, C: Counters, L: Leaves<C>>(
                 counters.box_tests(WIDTH as u32);
                 // SAFETY: the caller's guarantee.
                 let mut mask = unsafe { kernel.children(node, ray, limit, &mut dist) };
-                prefetch_children(nodes, node, mask, leaves);
                 if mask != 0 {
                     // The farthest child first (the likeliest to hold an occluder: see the
-                    // module documentation), the others pushed as they come.
+                    // module documentation), the others pushed as they come; each asked for as
+                    // it is met (see `prefetch_children_of`), unless it is the only one.
                     let mut farthest = mask.trailing_zeros() as usize;
                     mask &= mask - 1;
+                    if mask != 0 {
+                        prefetch_child(nodes, node.children[farthest], |first| leaves.prefetch(first));
+                    }
                     while mask != 0 {
                         let i = mask.trailing_zeros() as usize;
                         mask &= mask - 1;
+                        prefetch_child(nodes, node.children[i], |first| leaves.prefetch(first));
                         let push = if dist[i] > dist[farthest] { std::mem::replace(&mut farthest, i) } else { i };
                         stack[len].write(Entry {
                             reference: node.children[push],
