@@ -79,8 +79,7 @@ pub(super) fn prefetch_children_of(nodes: &[WideNode], node: &WideNode, mut mask
         return;
     }
     while mask != 0 {
-        let i = mask.trailing_zeros() as usize;
-        mask &= mask - 1;
+        let i = take_lowest(&mut mask);
         prefetch_child(nodes, node.children[i], &leaf);
     }
 }
@@ -160,6 +159,14 @@ fn prepare_once<'p, C: Counters, L: Leaves<C>>(slot: &'p mut Option<L::Prepared>
     unsafe { slot.as_ref().unwrap_unchecked() }
 }
 
+/// The lowest slot set in `mask`, cleared from it (`mask` must not be empty).
+#[inline(always)]
+fn take_lowest(mask: &mut u32) -> usize {
+    let slot = mask.trailing_zeros() as usize;
+    *mask &= *mask - 1;
+    slot
+}
+
 /// The two entries with the farther one first, as they go on the stack; a tie keeps them in
 /// their order (only a strictly nearer second entry is swapped), as an insertion sort does.
 #[inline(always)]
@@ -205,8 +212,7 @@ pub unsafe fn closest<K: NodeKernel, C: Counters, L: Leaves<C>>(
                 // SAFETY: the caller's guarantee.
                 let mut mask = unsafe { kernel.children(node, ray, reach(leaves.t_max()), &mut dist) };
                 if mask != 0 {
-                    let first = mask.trailing_zeros() as usize;
-                    mask &= mask - 1;
+                    let first = take_lowest(&mut mask);
                     if mask == 0 {
                         // A lone child is not asked for: it is read next.
                         current =
@@ -214,8 +220,7 @@ pub unsafe fn closest<K: NodeKernel, C: Counters, L: Leaves<C>>(
                         continue;
                     }
                     let a = asked_entry(nodes, node, first, &dist, leaves);
-                    let second = mask.trailing_zeros() as usize;
-                    mask &= mask - 1;
+                    let second = take_lowest(&mut mask);
                     let b = asked_entry(nodes, node, second, &dist, leaves);
                     if mask == 0 {
                         let (near, far) = if b.t < a.t { (b, a) } else { (a, b) };
@@ -227,8 +232,7 @@ pub unsafe fn closest<K: NodeKernel, C: Counters, L: Leaves<C>>(
                     // Three or more: the first four sorted in registers, farthest first (the
                     // order an insertion sort gives, ties kept in slot order); the rest, if any,
                     // pushed above them and sorted in on the stack. The nearest is entered.
-                    let third = mask.trailing_zeros() as usize;
-                    mask &= mask - 1;
+                    let third = take_lowest(&mut mask);
                     let c = asked_entry(nodes, node, third, &dist, leaves);
                     let (a, b) = farther_first(a, b);
                     let (b, c) = farther_first(b, c);
@@ -240,8 +244,7 @@ pub unsafe fn closest<K: NodeKernel, C: Counters, L: Leaves<C>>(
                         current = c;
                         continue;
                     }
-                    let fourth = mask.trailing_zeros() as usize;
-                    mask &= mask - 1;
+                    let fourth = take_lowest(&mut mask);
                     let d = asked_entry(nodes, node, fourth, &dist, leaves);
                     let (c, d) = farther_first(c, d);
                     let (b, c) = farther_first(b, c);
@@ -258,8 +261,7 @@ pub unsafe fn closest<K: NodeKernel, C: Counters, L: Leaves<C>>(
                     stack[len + 3].write(d);
                     len += 4;
                     while mask != 0 {
-                        let i = mask.trailing_zeros() as usize;
-                        mask &= mask - 1;
+                        let i = take_lowest(&mut mask);
                         stack[len].write(asked_entry(nodes, node, i, &dist, leaves));
                         len += 1;
                     }
@@ -339,14 +341,12 @@ pub unsafe fn any<K: NodeKernel, C: Counters, L: Leaves<C>>(
                     // The farthest child first (the likeliest to hold an occluder: see the
                     // module documentation), the others pushed as they come; each asked for as
                     // it is met (see `prefetch_children_of`), unless it is the only one.
-                    let mut farthest = mask.trailing_zeros() as usize;
-                    mask &= mask - 1;
+                    let mut farthest = take_lowest(&mut mask);
                     if mask != 0 {
                         prefetch_child(nodes, node.children[farthest], |first| leaves.prefetch(first));
                     }
                     while mask != 0 {
-                        let i = mask.trailing_zeros() as usize;
-                        mask &= mask - 1;
+                        let i = take_lowest(&mut mask);
                         prefetch_child(nodes, node.children[i], |first| leaves.prefetch(first));
                         let push = if dist[i] > dist[farthest] { std::mem::replace(&mut farthest, i) } else { i };
                         stack[len].write(Entry {
