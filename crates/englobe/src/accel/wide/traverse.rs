@@ -3,7 +3,7 @@
 //! without another test if a closer hit is found before they are popped. This is the traversal
 //! of Wald, Benthin and Boulos (2008), "Getting Rid of Packets: Efficient SIMD Single-Ray
 //! Traversal using Multi-branching BVHs", in the form Embree's `BVHNIntersector1` gives it (Wald
-//! et al. 2014): no sorting at all when one child or two are hit (the common cases), up to four
+//! et al. 2014): no sorting at all when one child or two are hit (the common cases), up to five
 //! sorted in registers by compare-and-swap, an insertion sort on the stack for the rest.
 //!
 //! Occlusion queries stop at the first occluder and do not sort: they enter the *farthest* child
@@ -229,7 +229,7 @@ pub unsafe fn closest<K: NodeKernel, C: Counters, L: Leaves<C>>(
                         current = near;
                         continue;
                     }
-                    // Three or more: the first four sorted in registers, farthest first (the
+                    // Three or more: the first five sorted in registers, farthest first (the
                     // order an insertion sort gives, ties kept in slot order); the rest, if any,
                     // pushed above them and sorted in on the stack. The nearest is entered.
                     let third = take_lowest(&mut mask);
@@ -249,23 +249,38 @@ pub unsafe fn closest<K: NodeKernel, C: Counters, L: Leaves<C>>(
                     let (c, d) = farther_first(c, d);
                     let (b, c) = farther_first(b, c);
                     let (a, b) = farther_first(a, b);
-                    stack[len].write(a);
-                    stack[len + 1].write(b);
-                    stack[len + 2].write(c);
                     if mask == 0 {
+                        stack[len].write(a);
+                        stack[len + 1].write(b);
+                        stack[len + 2].write(c);
                         len += 3;
                         current = d;
                         continue;
                     }
-                    let base = len;
+                    let fifth = take_lowest(&mut mask);
+                    let e = asked_entry(nodes, node, fifth, &dist, leaves);
+                    let (d, e) = farther_first(d, e);
+                    let (c, d) = farther_first(c, d);
+                    let (b, c) = farther_first(b, c);
+                    let (a, b) = farther_first(a, b);
+                    stack[len].write(a);
+                    stack[len + 1].write(b);
+                    stack[len + 2].write(c);
                     stack[len + 3].write(d);
-                    len += 4;
+                    if mask == 0 {
+                        len += 4;
+                        current = e;
+                        continue;
+                    }
+                    let base = len;
+                    stack[len + 4].write(e);
+                    len += 5;
                     while mask != 0 {
                         let i = take_lowest(&mut mask);
                         stack[len].write(asked_entry(nodes, node, i, &dist, leaves));
                         len += 1;
                     }
-                    for i in base + 4..len {
+                    for i in base + 5..len {
                         // SAFETY: entries below `len` were written.
                         let e = unsafe { stack[i].assume_init() };
                         let mut j = i;
