@@ -30,6 +30,7 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 use crate::Aabb;
+use crate::accel::MAX_PRIMITIVES;
 use crate::shapes::clip::Polygon;
 
 /// Most pieces one triangle is cut into.
@@ -57,7 +58,8 @@ fn wasted_area(v: &[Vec3; 3], b: &Aabb) -> f32 {
 /// triangles are cut in parallel; the fragments come in triangle order, whatever the threads.
 pub fn presplit(boxes: &[Aabb], triangle: impl Fn(u32) -> [Vec3; 3] + Sync, budget: f32) -> Fragments {
     let count = boxes.len();
-    let extra = (budget.max(0.0) * count as f32) as usize;
+    // References stay within what a build may hold (its bins count them in `i32` lanes).
+    let extra = ((budget.max(0.0) * count as f32) as usize).min(MAX_PRIMITIVES.saturating_sub(count));
     let whole = || Fragments { boxes: boxes.to_vec(), owner: (0..count as u32).collect() };
     if extra == 0 {
         return whole();

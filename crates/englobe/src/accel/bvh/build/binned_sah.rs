@@ -13,7 +13,7 @@
 //! `C_i * N`. When the centroids coincide, no plane separates them and the shared top-down driver
 //! ([`super::top_down`]) splits by count. Large subtrees are built in parallel.
 
-use glam::{BVec4A, Vec3A, Vec4};
+use glam::{BVec4A, IVec4, Vec3A, Vec4};
 
 use super::top_down::{self, PrimRef, Splitter, partition, split_beats_leaf};
 use crate::Aabb;
@@ -21,6 +21,8 @@ use crate::accel::bvh::{BuildTree, Bvh};
 
 /// Most bins per axis.
 pub const MAX_BINS: usize = 32;
+// A bin index is masked with `MAX_BINS - 1` to spare bounds checks.
+const _: () = assert!(MAX_BINS.is_power_of_two());
 /// Default most primitives per leaf of the SAH builders.
 pub const DEFAULT_MAX_LEAF: usize = 8;
 
@@ -57,24 +59,29 @@ impl BinnedSah {
 }
 
 /// One slab of one axis: the box of the primitives whose centroids fall in it (as SIMD vectors:
-/// the sweep is the builder's hot loop), and their number.
+/// the sweep is the builder's hot loop). Their number is kept apart, in [`Bins::counts`].
 #[derive(Clone, Copy, Debug)]
 struct Bin {
     min: Vec3A,
     max: Vec3A,
-    count: u32,
 }
 
-const EMPTY_BIN: Bin = Bin { min: Vec3A::INFINITY, max: Vec3A::NEG_INFINITY, count: 0 };
+const EMPTY_BIN: Bin = Bin { min: Vec3A::INFINITY, max: Vec3A::NEG_INFINITY };
 
 /// The bins of the three axes, kept by each thread from node to node: a node clears only the
-/// bins it uses (8 of the 32 in small nodes) instead of copying a fresh 4.5 KiB array.
+/// bins it uses (8 of the 32 in small nodes) instead of copying a fresh 3.5 KiB array.
 #[derive(Clone, Debug)]
-pub struct Bins([[Bin; MAX_BINS]; 3]);
+pub struct Bins {
+    boxes: [[Bin; MAX_BINS]; 3],
+    /// `counts[i]`: the primitives in bin `i` of each axis, lane `a` for axis `a`: the sweep adds
+    /// the three axes' counts with one vector addition. Counts fit: a node holds at most
+    /// [`crate::accel::MAX_PRIMITIVES`] (2^31 - 1) references.
+    counts: [IVec4; MAX_BINS],
+}
 
 impl Default for Bins {
     fn default() -> Self {
-        Bins([[EMPTY_BIN; MAX_BINS]; 3])
+        Bins { boxes: [[EMPTY_BIN; MAX_BINS]; 3], counts: [IVec4::ZERO; MAX_BINS] }
     }
 }
 
@@ -83,22 +90,20 @@ impl Bin {
     fn add(&mut self, min: Vec3A, max: Vec3A) {
         self.min = self.min.min(min);
         self.max = self.max.max(max);
-        self.count += 1;
     }
 
     #[inline(always)]
     fn merge(&mut self, other: &Bin) {
         self.min = self.min.min(other.min);
         self.max = self.max.max(other.max);
-        self.count += other.count;
     }
 
-    /// Surface area times count ([`Aabb::surface_area`]'s formula): the one-box form that
+    /// Surface area times `count` ([`Aabb::surface_area`]'s formula): the one-box form that
     /// [`weighted_areas`] is tested against.
     #[cfg(test)]
-    fn weighted_area(&self) -> f32 {
+    fn weighted_area(&self, count: u32) -> f32 {
         let e = self.max - self.min;
-        2.0 * (e.x * e.y + e.y * e.z + e.z * e.x) * self.count as f32
+        2.0 * (e.x * e.y + e.y * e.z + e.z * e.x) * count as f32
     }
 }
 
@@ -111,13 +116,14 @@ fn bin_of(c: f32, min: f32, scale: f32, bins: usize) -> usize {
     (((c - min) * scale) as usize).min(bins - 1)
 }
 
-/// Whether coordinate `c` falls in a bin before `plane` (`bin_of(c, min, scale, bins) < plane`
-/// for any `plane` in `1..bins`) as one comparison: the bin is the integer part of the product
-/// (0 for a negative product or NaN), so it is below the integer `plane` exactly when the product
-/// is, or is NaN.
+/// Which coordinates of `c` fall in a bin at or past `plane` (bit `a` of the result set when
+/// `bin_of(c[a], min[a], scale[a], bins) >= plane`, for any `plane` in `1..bins`), one comparison
+/// per lane: the bin is the integer part of the product (0 for a negative product or NaN), so it
+/// reaches the integer `plane` exactly when the product does. All lanes at once, so that the
+/// partition reads no lane chosen at run time.
 #[inline(always)]
-fn before_plane(c: f32, min: f32, scale: f32, plane: f32) -> bool {
-    !((c - min) * scale >= plane)
+fn past_plane(c: Vec4, min: Vec4, scale: Vec4, plane: Vec4) -> u32 {
+    ((c - min) * scale).cmpge(plane).bitmask()
 }
 
 /// [`bin_of`] on the three coordinates of `c` at once, `last` being `bins - 1` in each lane: the
@@ -139,13 +145,15 @@ fn bin_vector(c: Vec3A, min: Vec3A, scale: Vec3A, last: Vec3A) -> [u32; 3] {
 }
 
 /// The weighted areas ([`Bin::weighted_area`], computed as it computes them) of three boxes, lane
-/// `a` the box of axis `a`'s bins, and their counts.
+/// `a` the box of axis `a`'s bins, and their counts (`counts`, lane `a` axis `a`'s) as floats.
 #[inline(always)]
-fn weighted_areas(sides: &[Bin; 3]) -> (Vec4, Vec4) {
+fn weighted_areas(sides: &[Bin; 3], counts: IVec4) -> (Vec4, Vec4) {
     let e = sides.map(|b| b.max - b.min);
     let lanes = |f: fn(Vec3A) -> f32| Vec4::new(f(e[0]), f(e[1]), f(e[2]), 0.0);
     let (ex, ey, ez) = (lanes(|v| v.x), lanes(|v| v.y), lanes(|v| v.z));
-    let count = Vec4::new(sides[0].count as f32, sides[1].count as f32, sides[2].count as f32, 0.0);
+    // Exact conversions: a count below 2^31 is the same float whether converted from an `i32`
+    // or from the `u32` it would otherwise be.
+    let count = counts.as_vec4();
     (Vec4::splat(2.0) * (ex * ey + ey * ez + ez * ex) * count, count)
 }
 
@@ -154,26 +162,28 @@ fn weighted_areas(sides: &[Bin; 3]) -> (Vec4, Vec4) {
 /// one per vector lane (as Embree's binner does); each lane keeps the first plane of least cost,
 /// and the axes are then compared in order, so the plane is the one a sweep of axis 0, then 1,
 /// then 2 would keep (the first of least cost).
-fn best_plane(bins: &[[Bin; MAX_BINS]; 3], k: usize, splittable: [bool; 3]) -> Option<(f32, usize, usize)> {
+fn best_plane(bins: &Bins, k: usize, splittable: [bool; 3]) -> Option<(f32, usize, usize)> {
     // right[i]: area times count of bins i.. of each axis (for the planes before bin i, i in
     // 1..k), NaN where they are empty.
     let mut right = [Vec4::NAN; MAX_BINS];
-    let mut side = [EMPTY_BIN; 3];
+    let (mut side, mut side_count) = ([EMPTY_BIN; 3], IVec4::ZERO);
     for i in (1..k).rev() {
-        for (s, axis) in side.iter_mut().zip(bins) {
+        for (s, axis) in side.iter_mut().zip(&bins.boxes) {
             s.merge(&axis[i]);
         }
-        let (weighted, count) = weighted_areas(&side);
+        side_count += bins.counts[i];
+        let (weighted, count) = weighted_areas(&side, side_count);
         right[i] = Vec4::select(count.cmpeq(Vec4::ZERO), Vec4::NAN, weighted);
     }
     let allowed = BVec4A::new(splittable[0], splittable[1], splittable[2], false);
     let (mut cost, mut plane, mut found) = (Vec4::ZERO, Vec4::ZERO, BVec4A::splat(false));
-    let mut side = [EMPTY_BIN; 3];
+    let (mut side, mut side_count) = ([EMPTY_BIN; 3], IVec4::ZERO);
     for i in 1..k {
-        for (s, axis) in side.iter_mut().zip(bins) {
+        for (s, axis) in side.iter_mut().zip(&bins.boxes) {
             s.merge(&axis[i - 1]);
         }
-        let (weighted, count) = weighted_areas(&side);
+        side_count += bins.counts[i - 1];
+        let (weighted, count) = weighted_areas(&side, side_count);
         let valid = allowed & count.cmpne(Vec4::ZERO) & !right[i].is_nan_mask();
         let here = weighted + right[i];
         let better = valid & (!found | here.cmplt(cost));
@@ -218,10 +228,11 @@ impl Splitter for BinnedSah {
             return None;
         }
         let min = centroid_bounds.min;
-        let bins = &mut scratch.0;
-        for axis in bins.iter_mut() {
+        let bins = scratch;
+        for axis in bins.boxes.iter_mut() {
             axis[..k].fill(EMPTY_BIN);
         }
+        bins.counts[..k].fill(IVec4::ZERO);
         // All three axes' bins at once, each coordinate as `bin_of` places it (an axis that
         // cannot be split fills its first bin, which no plane reads).
         let (c_min, c_scale) = (Vec3A::from(min), Vec3A::from_array(scale));
@@ -229,9 +240,11 @@ impl Splitter for BinnedSah {
         for r in refs.iter() {
             let (lo, hi) = (r.min(), r.max());
             let slot = bin_vector(r.centroid(), c_min, c_scale, last);
-            for (axis, bins) in bins.iter_mut().enumerate() {
-                // `slot` is below `k` already; the `min` only spares the bounds check.
-                bins[(slot[axis] as usize).min(MAX_BINS - 1)].add(lo, hi);
+            // `slot` is below `k` already; the mask only spares the bounds checks.
+            let slot = slot.map(|i| i as usize & (MAX_BINS - 1));
+            for (axis, boxes) in bins.boxes.iter_mut().enumerate() {
+                boxes[slot[axis]].add(lo, hi);
+                bins.counts[slot[axis]][axis] += 1;
             }
         }
 
@@ -239,8 +252,9 @@ impl Splitter for BinnedSah {
         if !must_split && !split_beats_leaf(weighted, bounds.surface_area(), refs.len()) {
             return None;
         }
-        let (lo, s, plane) = (min[axis], scale[axis], plane as f32);
-        Some(partition(refs, |r| before_plane(r.centroid_on(axis), lo, s, plane)))
+        let plane = plane as f32;
+        let (c_min, c_scale, c_plane) = (Vec4::from((c_min, 0.0)), Vec4::from((c_scale, 0.0)), Vec4::splat(plane));
+        Some(partition(refs, |r| past_plane(r.centroid4(), c_min, c_scale, c_plane) >> axis & 1 == 0))
     }
 }
 
@@ -316,9 +330,13 @@ mod tests {
                 [x, y, z].iter().enumerate().map(|(a, &c)| bin_of(c, min[a], scale[a], 8) as u32).collect::<Vec<_>>();
             assert_eq!(got.to_vec(), expected, "{x} {y} {z}");
             // The partition's comparison is the placement's, at every plane.
+            let c = Vec4::new(x, y, z, f32::NAN);
             for plane in 1..8 {
-                let before = before_plane(x, min.x, scale.x, plane as f32);
-                assert_eq!(before, bin_of(x, min.x, scale.x, 8) < plane, "{x} at plane {plane}");
+                let past = past_plane(c, min.extend(0.0), scale.extend(0.0), Vec4::splat(plane as f32));
+                for (a, &c) in [x, y, z].iter().enumerate() {
+                    let expected = bin_of(c, min[a], scale[a], 8) >= plane;
+                    assert_eq!(past >> a & 1 == 1, expected, "{c} on axis {a} at plane {plane}");
+                }
             }
         }
     }
@@ -335,12 +353,17 @@ mod tests {
         for _ in 0..1000 {
             let sides = [0, 1, 2].map(|_| {
                 let (a, b) = (Vec3A::new(next(), next(), next()), Vec3A::new(next(), next(), next()));
-                Bin { min: a.min(b), max: a.max(b), count: (next().abs() * 1000.0) as u32 }
+                Bin { min: a.min(b), max: a.max(b) }
             });
-            let (weighted, count) = weighted_areas(&sides);
+            // Counts up to the largest a node may hold.
+            let counts =
+                [0, 1, 2].map(|_| (((next().abs() / 100.0).powi(8) * i32::MAX as f32) as u32).min(i32::MAX as u32));
+            let lanes = IVec4::new(counts[0] as i32, counts[1] as i32, counts[2] as i32, 0);
+            let (weighted, count) = weighted_areas(&sides, lanes);
             for (axis, side) in sides.iter().enumerate() {
-                assert_eq!(weighted[axis].to_bits(), side.weighted_area().to_bits(), "{side:?}");
-                assert_eq!(count[axis], side.count as f32);
+                let expected = side.weighted_area(counts[axis]);
+                assert_eq!(weighted[axis].to_bits(), expected.to_bits(), "{side:?} {counts:?}");
+                assert_eq!(count[axis], counts[axis] as f32);
             }
         }
     }

@@ -79,6 +79,13 @@ impl PrimRef {
         (self.min() + self.max()) * 0.5
     }
 
+    /// The box's centre in the first three lanes (as [`PrimRef::centroid`]); the fourth is
+    /// meaningless.
+    #[inline(always)]
+    pub fn centroid4(&self) -> Vec4 {
+        (self.lo + self.hi) * 0.5
+    }
+
     /// Coordinate `axis` of the box's centre (as [`PrimRef::centroid`], one axis).
     #[inline(always)]
     pub fn centroid_on(&self, axis: usize) -> f32 {
