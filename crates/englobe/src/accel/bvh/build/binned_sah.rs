@@ -15,7 +15,8 @@
 
 use glam::{BVec4A, IVec4, Vec3A, Vec4};
 
-use super::top_down::{self, PrimRef, Splitter, partition, split_beats_leaf};
+use super::parallel;
+use super::top_down::{self, PIECE, PIECES_MIN, PrimRef, Splitter, partition_large, split_beats_leaf};
 use crate::Aabb;
 use crate::accel::bvh::{BuildTree, Bvh};
 
@@ -104,6 +105,57 @@ impl Bin {
     fn weighted_area(&self, count: u32) -> f32 {
         let e = self.max - self.min;
         2.0 * (e.x * e.y + e.y * e.z + e.z * e.x) * count as f32
+    }
+}
+
+/// Where a node's references go: the first of its `k` bins per axis starts at `min`, and `scale`
+/// bins fit in a unit (0 for an axis the centroids do not spread along); `last` is `k - 1`.
+#[derive(Clone, Copy)]
+struct Placement {
+    min: Vec3A,
+    scale: Vec3A,
+    last: Vec3A,
+    k: usize,
+}
+
+impl Placement {
+    /// Empties the first `k` bins of `bins`.
+    fn clear(&self, bins: &mut Bins) {
+        for axis in bins.boxes.iter_mut() {
+            axis[..self.k].fill(EMPTY_BIN);
+        }
+        bins.counts[..self.k].fill(IVec4::ZERO);
+    }
+
+    /// Empties the first `k` bins of `bins`, then drops each reference of `refs` into its bin
+    /// of each axis ([`bin_vector`]).
+    #[inline(always)]
+    fn bin(&self, refs: &[PrimRef], bins: &mut Bins) {
+        self.clear(bins);
+        for r in refs.iter() {
+            let (lo, hi) = (r.min(), r.max());
+            let slot = bin_vector(r.centroid(), self.min, self.scale, self.last);
+            // `slot` is below `k` already; the mask only spares the bounds checks.
+            let slot = slot.map(|i| i as usize & (MAX_BINS - 1));
+            for (axis, boxes) in bins.boxes.iter_mut().enumerate() {
+                boxes[slot[axis]].add(lo, hi);
+                bins.counts[slot[axis]][axis] += 1;
+            }
+        }
+    }
+}
+
+impl Bins {
+    /// Adds `other`'s first `k` bins of each axis to this one's.
+    fn merge(&mut self, other: &Bins, k: usize) {
+        for (mine, theirs) in self.boxes.iter_mut().zip(&other.boxes) {
+            for (a, b) in mine[..k].iter_mut().zip(&theirs[..k]) {
+                a.merge(b);
+            }
+        }
+        for (a, b) in self.counts[..k].iter_mut().zip(&other.counts[..k]) {
+            *a += *b;
+        }
     }
 }
 
@@ -228,25 +280,27 @@ impl Splitter for BinnedSah {
             return None;
         }
         let min = centroid_bounds.min;
-        let bins = scratch;
-        for axis in bins.boxes.iter_mut() {
-            axis[..k].fill(EMPTY_BIN);
-        }
-        bins.counts[..k].fill(IVec4::ZERO);
         // All three axes' bins at once, each coordinate as `bin_of` places it (an axis that
         // cannot be split fills its first bin, which no plane reads).
         let (c_min, c_scale) = (Vec3A::from(min), Vec3A::from_array(scale));
-        let last = Vec3A::splat((k - 1) as f32);
-        for r in refs.iter() {
-            let (lo, hi) = (r.min(), r.max());
-            let slot = bin_vector(r.centroid(), c_min, c_scale, last);
-            // `slot` is below `k` already; the mask only spares the bounds checks.
-            let slot = slot.map(|i| i as usize & (MAX_BINS - 1));
-            for (axis, boxes) in bins.boxes.iter_mut().enumerate() {
-                boxes[slot[axis]].add(lo, hi);
-                bins.counts[slot[axis]][axis] += 1;
+        let place = Placement { min: c_min, scale: c_scale, last: Vec3A::splat((k - 1) as f32), k };
+        let bins = if refs.len() < PIECES_MIN {
+            place.bin(refs, scratch);
+            scratch
+        } else {
+            // Large ranges in pieces, in parallel; merged, their bins are the ones one pass
+            // would fill (unions and sums, exact in any order).
+            let pieces = parallel::map_chunks(refs, PIECE, |piece| {
+                let mut bins = Box::<Bins>::default();
+                place.bin(piece, &mut bins);
+                bins
+            });
+            place.clear(scratch);
+            for piece in &pieces {
+                scratch.merge(piece, k);
             }
-        }
+            scratch
+        };
 
         let (weighted, axis, plane) = best_plane(bins, k, scale.map(|s| s > 0.0))?;
         if !must_split && !split_beats_leaf(weighted, bounds.surface_area(), refs.len()) {
@@ -254,7 +308,7 @@ impl Splitter for BinnedSah {
         }
         let plane = plane as f32;
         let (c_min, c_scale, c_plane) = (Vec4::from((c_min, 0.0)), Vec4::from((c_scale, 0.0)), Vec4::splat(plane));
-        Some(partition(refs, |r| past_plane(r.centroid4(), c_min, c_scale, c_plane) >> axis & 1 == 0))
+        Some(partition_large(refs, |r| past_plane(r.centroid4(), c_min, c_scale, c_plane) >> axis & 1 == 0))
     }
 }
 
@@ -366,6 +420,43 @@ mod tests {
                 assert_eq!(count[axis], counts[axis] as f32);
             }
         }
+    }
+
+    #[test]
+    fn a_large_range_binned_in_pieces_fills_the_bins_of_one_pass() {
+        let mut state = 0x9e37_79b9_u32;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 17;
+            state ^= state << 5;
+            (state >> 8) as f32 / (1 << 24) as f32 * 100.0
+        };
+        let boxes: Vec<Aabb> = (0..PIECES_MIN + 3 * PIECE / 2)
+            .map(|_| cube(Vec3::new(next(), next(), next() * 0.1), next() * 0.01))
+            .collect();
+        let refs: Vec<PrimRef> = boxes.iter().enumerate().map(|(i, b)| PrimRef::new(b, i as u32)).collect();
+        let k = 13;
+        let place = Placement { min: Vec3A::ZERO, scale: Vec3A::splat(0.13), last: Vec3A::splat(12.0), k };
+        let mut whole = Bins::default();
+        place.bin(&refs, &mut whole);
+        let mut merged = Bins::default();
+        place.clear(&mut merged);
+        for piece in refs.chunks(PIECE) {
+            let mut bins = Bins::default();
+            place.bin(piece, &mut bins);
+            merged.merge(&bins, k);
+        }
+        for i in 0..k {
+            assert_eq!(whole.counts[i], merged.counts[i]);
+            for axis in 0..3 {
+                let (a, b) = (whole.boxes[axis][i], merged.boxes[axis][i]);
+                assert_eq!((a.min, a.max), (b.min, b.max), "bin {i} of axis {axis}");
+            }
+        }
+        assert_eq!(whole.counts[..k].iter().map(|c| c.x).sum::<i32>() as usize, refs.len());
+        // The tree over them, built with pieces at its top levels, is sound.
+        let q = validate_bvh(&BinnedSah::default().build(&boxes), &boxes).unwrap();
+        assert!(q.max_leaf <= DEFAULT_MAX_LEAF, "{q:?}");
     }
 
     #[test]

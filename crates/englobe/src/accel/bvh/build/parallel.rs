@@ -1,6 +1,7 @@
 //! The little parallelism the builders need, with and without the `parallel` feature: two
 //! closures side by side (rayon's `join`, the fork-join model of Blumofe and Leiserson (1999),
-//! "Scheduling Multithreaded Computations by Work Stealing"), and a map over a slice.
+//! "Scheduling Multithreaded Computations by Work Stealing"), and maps over a slice and over its
+//! fixed-size pieces.
 //!
 //! Without the feature everything runs in order on the calling thread. The builders produce the
 //! same tree either way: parallel parts only ever work on disjoint data and are joined in a fixed
@@ -48,6 +49,33 @@ pub fn all_mut<T: Send>(v: &mut [T], min_chunk: usize, f: impl Fn(&mut T) -> boo
     v.iter_mut().fold(true, |ok, x| f(x) & ok)
 }
 
+/// `f` of each `chunk`-long piece of `v` (the last one shorter), in order; the pieces run in
+/// parallel when the `parallel` feature is on. The pieces depend on `chunk` alone, never on the
+/// threads, so the result is the same either way.
+#[inline]
+pub fn map_chunks_mut<T: Send, R: Send>(v: &mut [T], chunk: usize, f: impl Fn(&mut [T]) -> R + Sync) -> Vec<R> {
+    let chunk = chunk.max(1);
+    #[cfg(feature = "parallel")]
+    if v.len() > chunk {
+        use rayon::prelude::*;
+        return v.par_chunks_mut(chunk).map(&f).collect();
+    }
+    v.chunks_mut(chunk).map(f).collect()
+}
+
+/// `f` of each `chunk`-long piece of `v` (the last one shorter), in order, as
+/// [`map_chunks_mut`] does for a slice it may change.
+#[inline]
+pub fn map_chunks<T: Sync, R: Send>(v: &[T], chunk: usize, f: impl Fn(&[T]) -> R + Sync) -> Vec<R> {
+    let chunk = chunk.max(1);
+    #[cfg(feature = "parallel")]
+    if v.len() > chunk {
+        use rayon::prelude::*;
+        return v.par_chunks(chunk).map(&f).collect();
+    }
+    v.chunks(chunk).map(f).collect()
+}
+
 /// Sorts `v` (unstably: give keys that are unique, or equal elements that are identical, for a
 /// deterministic order), in parallel when the `parallel` feature is on and `v` is long.
 #[inline]
@@ -74,5 +102,11 @@ mod tests {
         sort_unstable_by_key(&mut keyed, |&(v, i)| (v, i));
         assert!(keyed.windows(2).all(|w| w[0] < w[1]));
         assert_eq!(join(|| 1, || 2), (1, 2));
+        // Pieces in order, whatever the threads.
+        let mut v: Vec<u32> = (0..10_000).collect();
+        let firsts = map_chunks_mut(&mut v, 3000, |c| c[0]);
+        assert_eq!(firsts, [0, 3000, 6000, 9000]);
+        assert_eq!(map_chunks(&v, 700, |c| c.len()), [[700; 14].as_slice(), &[200]].concat());
+        assert!(map_chunks(&[] as &[u32], 7, |c| c.len()).is_empty());
     }
 }

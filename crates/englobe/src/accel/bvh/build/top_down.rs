@@ -129,6 +129,15 @@ const PARALLEL_MIN: usize = 4096;
 /// [`PARALLEL_MIN`] references, the explicit work stack takes over.
 const PARALLEL_DEPTH: u32 = 40;
 
+/// Ranges of at least this many references are bounded, binned and partitioned in pieces of
+/// [`PIECE`] references, the pieces in parallel. Above it the two halves of a node cannot keep
+/// the cores busy on their own: the root's passes would run on one core, and so would each node
+/// along a chain of uneven splits, whose passes add up to several times the root's.
+pub const PIECES_MIN: usize = 1 << 15;
+/// References per piece of a large range (see [`PIECES_MIN`]): a fixed size, so that the pieces,
+/// and hence the partition's order, never depend on the threads.
+pub const PIECE: usize = 1 << 13;
+
 /// Builds the tree over `boxes` (primitive `i` has box `boxes[i]`) with `splitter`.
 pub fn build_tree<S: Splitter>(splitter: &S, boxes: &[Aabb]) -> BuildTree {
     let n = boxes.len();
@@ -145,8 +154,18 @@ pub fn build_tree<S: Splitter>(splitter: &S, boxes: &[Aabb]) -> BuildTree {
     BuildTree { nodes, prims, root: 0 }
 }
 
-/// The union of the references' boxes and the box around their centroids.
+/// The union of the references' boxes and the box around their centroids (in pieces, in
+/// parallel, for a large range: see [`PIECES_MIN`]).
 pub fn range_bounds(refs: &[PrimRef]) -> (Aabb, Aabb) {
+    if refs.len() < PIECES_MIN {
+        return piece_bounds(refs);
+    }
+    let pieces = parallel::map_chunks(refs, PIECE, piece_bounds);
+    pieces.into_iter().fold((Aabb::EMPTY, Aabb::EMPTY), |(b, c), (pb, pc)| (b.union(&pb), c.union(&pc)))
+}
+
+/// [`range_bounds`] in one pass.
+fn piece_bounds(refs: &[PrimRef]) -> (Aabb, Aabb) {
     let (mut lo, mut hi) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
     let (mut c_lo, mut c_hi) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
     for r in refs {
@@ -274,6 +293,34 @@ pub fn partition(refs: &mut [PrimRef], mut left: impl FnMut(&PrimRef) -> bool) -
     first
 }
 
+/// [`partition`] for a range of any size: a large one (see [`PIECES_MIN`]) is partitioned piece by
+/// piece, in parallel, and the references left on the wrong side of the boundary are then swapped
+/// pairwise, in order.
+pub fn partition_large(refs: &mut [PrimRef], left: impl Fn(&PrimRef) -> bool + Sync) -> usize {
+    if refs.len() < PIECES_MIN {
+        return partition(refs, left);
+    }
+    let firsts = parallel::map_chunks_mut(refs, PIECE, |piece| partition(piece, &left));
+    let mid: usize = firsts.iter().sum();
+    // Piece `j` starts at `j * PIECE` with its `firsts[j]` chosen references. The pieces' second
+    // sides before `mid` and their first sides from `mid` on hold as many references.
+    let (mut early, mut late) = (Vec::new(), Vec::new());
+    for (j, &first) in firsts.iter().enumerate() {
+        let start = j * PIECE;
+        let (split, end) = (start + first, (start + PIECE).min(refs.len()));
+        if split < mid {
+            early.push(split..end.min(mid));
+        }
+        if split > mid {
+            late.push(start.max(mid)..split);
+        }
+    }
+    for (a, b) in early.into_iter().flatten().zip(late.into_iter().flatten()) {
+        refs.swap(a, b);
+    }
+    mid
+}
+
 #[cfg(test)]
 mod tests {
     use glam::Vec3;
@@ -362,5 +409,34 @@ mod tests {
         assert_eq!(partition(&mut refs, |_| true), 11);
         assert_eq!(partition(&mut refs, |_| false), 0);
         assert_eq!(partition(&mut [], |_| true), 0);
+    }
+
+    #[test]
+    fn a_large_range_is_partitioned_in_pieces_as_a_whole() {
+        let n = 3 * PIECE + PIECES_MIN + 17;
+        let b = boxes(n);
+        let fresh = || -> Vec<PrimRef> { b.iter().enumerate().map(|(i, b)| PrimRef::new(b, i as u32)).collect() };
+        // Chosen in runs and at random, none, all: whatever lands where, the chosen come first.
+        let runs = |i: u32| (i / 5000) % 3 == 1;
+        let scattered = |i: u32| i.wrapping_mul(2_654_435_761) >> 28 < 5;
+        let choices: [&(dyn Fn(u32) -> bool + Sync); 4] = [&runs, &scattered, &|_| false, &|_| true];
+        for choose in choices {
+            let mut refs = fresh();
+            let mid = partition_large(&mut refs, |r| choose(r.index()));
+            assert_eq!(mid, (0..n as u32).filter(|&i| choose(i)).count());
+            assert!(refs[..mid].iter().all(|r| choose(r.index())));
+            assert!(refs[mid..].iter().all(|r| !choose(r.index())));
+            let mut seen: Vec<u32> = refs.iter().map(|r| r.index()).collect();
+            seen.sort_unstable();
+            assert!(seen.iter().copied().eq(0..n as u32));
+            assert!(refs.iter().all(|r| r.bounds() == b[r.index() as usize]));
+            // The same order every time, whatever the threads did.
+            let mut again = fresh();
+            partition_large(&mut again, |r| choose(r.index()));
+            assert!(refs.iter().zip(&again).all(|(a, b)| a.index() == b.index()));
+        }
+        // The bounds in pieces are the bounds in one pass.
+        let refs = fresh();
+        assert_eq!(range_bounds(&refs), piece_bounds(&refs));
     }
 }
