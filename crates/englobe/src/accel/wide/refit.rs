@@ -26,7 +26,7 @@ use super::triangle_bvh::triangle_of;
 use super::triangles::{LANES, TriBlock, UNUSED, is_storable};
 use crate::Aabb;
 use crate::accel::MAX_PRIMITIVES;
-use crate::accel::bvh::build::parallel::all_mut;
+use crate::accel::bvh::build::parallel::{all_mut, map_chunks};
 use crate::accel::bvh::stats::{SAH_INTERSECTION_COST, SAH_TRAVERSAL_COST};
 use crate::shapes::{MeshError, TriangleMesh, check_arrays};
 
@@ -76,22 +76,27 @@ impl TriangleBvh {
         }
         let root = self.bounds.surface_area() as f64;
         let chance = |b: &Aabb| if root > 0.0 { b.surface_area() as f64 / root } else { 1.0 };
-        let mut cost = SAH_TRAVERSAL_COST as f64;
-        for node in &self.nodes {
-            for slot in (0..WIDTH).filter(|&s| node.children[s] != EMPTY) {
-                let (c, b) = (node.children[slot], node.child_bounds(slot));
-                cost += chance(&b)
-                    * if is_leaf(c) {
-                        let first = index_of(c) as usize;
-                        let tris: u32 =
-                            self.blocks[first..first + node.counts[slot] as usize].iter().map(TriBlock::used).sum();
-                        SAH_INTERSECTION_COST as f64 * tris as f64
-                    } else {
-                        SAH_TRAVERSAL_COST as f64
-                    };
+        // The nodes in fixed pieces, in parallel, their sums added in order: the same cost
+        // whatever the threads.
+        let pieces = map_chunks(&self.nodes, 1 << 12, |nodes| {
+            let mut cost = 0.0;
+            for node in nodes {
+                for slot in (0..WIDTH).filter(|&s| node.children[s] != EMPTY) {
+                    let (c, b) = (node.children[slot], node.child_bounds(slot));
+                    cost += chance(&b)
+                        * if is_leaf(c) {
+                            let first = index_of(c) as usize;
+                            let tris: u32 =
+                                self.blocks[first..first + node.counts[slot] as usize].iter().map(TriBlock::used).sum();
+                            SAH_INTERSECTION_COST as f64 * tris as f64
+                        } else {
+                            SAH_TRAVERSAL_COST as f64
+                        };
+                }
             }
-        }
-        cost as f32
+            cost
+        });
+        pieces.into_iter().fold(SAH_TRAVERSAL_COST as f64, |sum, piece| sum + piece) as f32
     }
 
     /// The SAH cost the tree had when it was built.

@@ -16,7 +16,7 @@ use super::presplit::presplit;
 use super::traverse::Leaves;
 use super::triangles::{LANES, TriBlock, TriRay, UNUSED, intersect_block, is_storable};
 use crate::accel::bvh::BinnedSah;
-use crate::accel::bvh::build::parallel::fill_indexed;
+use crate::accel::bvh::build::parallel::collect_indexed;
 use crate::accel::{Counters, Hit, HitFilter, LEAF_SIZE_BUCKETS, MAX_PRIMITIVES, NoFilter, StructureStats};
 use crate::geom::prefetch::prefetch;
 use crate::shapes::{MeshError, TriangleMesh, check_arrays};
@@ -135,8 +135,7 @@ impl Blocks<'_> {
     /// leaves' order, not the mesh's, so they mostly miss the caches, and they were the largest
     /// sequential part of a build.
     fn fill(&self, triangle: impl Fn(u32) -> [Vec3; 3] + Sync) -> Vec<TriBlock> {
-        let mut blocks = vec![TriBlock { v: [[0.0; LANES]; 9], ids: [UNUSED; LANES] }; self.blocks.len()];
-        fill_indexed(&mut blocks, 1 << 12, |i| {
+        collect_indexed(self.blocks.len(), 1 << 12, |i| {
             let ids = &self.blocks[i];
             let used = ids.iter().take_while(|&&id| id != UNUSED).count();
             let mut triangles = [(UNUSED, [Vec3::ZERO; 3]); LANES];
@@ -144,8 +143,7 @@ impl Blocks<'_> {
                 *slot = (id, triangle(id));
             }
             TriBlock::new(&triangles[..used])
-        });
-        blocks
+        })
     }
 }
 
@@ -189,8 +187,7 @@ impl TriangleBvh {
     /// are triangles with non-finite coordinates.
     pub fn build_with(count: usize, triangle: impl Fn(u32) -> [Vec3; 3] + Sync, options: TriangleBvhOptions) -> Self {
         let count = count.min(MAX_PRIMITIVES);
-        let mut boxes = vec![Aabb::EMPTY; count];
-        fill_indexed(&mut boxes, 1 << 14, |i| {
+        let boxes = collect_indexed(count, 1 << 14, |i| {
             let v = triangle(i as u32);
             if v.iter().all(|p| p.is_finite()) && is_storable(&v) { Aabb::from_points(v) } else { Aabb::EMPTY }
         });

@@ -36,6 +36,21 @@ pub fn fill_indexed<T: Send>(out: &mut [T], min_chunk: usize, f: impl Fn(usize) 
     }
 }
 
+/// A new vector of `f(i)` for `i` in `0..n`, made in parallel (in chunks of at least
+/// `min_chunk`) when the `parallel` feature is on and `n` is large enough. Each thread writes its
+/// part of the fresh memory first, so the page faults of a large vector are taken on every core,
+/// where filling a vector made by `vec![x; n]` would first take them all on one.
+#[inline]
+pub fn collect_indexed<T: Send>(n: usize, min_chunk: usize, f: impl Fn(usize) -> T + Sync) -> Vec<T> {
+    #[cfg(feature = "parallel")]
+    if n > min_chunk {
+        use rayon::prelude::*;
+        return (0..n).into_par_iter().with_min_len(min_chunk.max(1)).map(&f).collect();
+    }
+    let _ = min_chunk;
+    (0..n).map(f).collect()
+}
+
 /// Runs `f` on every element of `v`, in parallel (in chunks of at least `min_chunk`) when the
 /// `parallel` feature is on and `v` is long enough; true if `f` returned true for all of them.
 #[inline]
@@ -98,6 +113,7 @@ mod tests {
         let mut out = vec![0u64; 100_000];
         fill_indexed(&mut out, 1024, |i| (i as u64 * 2_654_435_761) % 1000);
         assert!(out.iter().enumerate().all(|(i, &v)| v == (i as u64 * 2_654_435_761) % 1000));
+        assert_eq!(collect_indexed(100_000, 1024, |i| (i as u64 * 2_654_435_761) % 1000), out);
         let mut keyed: Vec<(u64, usize)> = out.iter().copied().zip(0..).collect();
         sort_unstable_by_key(&mut keyed, |&(v, i)| (v, i));
         assert!(keyed.windows(2).all(|w| w[0] < w[1]));

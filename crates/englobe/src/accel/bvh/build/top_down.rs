@@ -144,13 +144,11 @@ pub fn build_tree<S: Splitter>(splitter: &S, boxes: &[Aabb]) -> BuildTree {
     if n == 0 {
         return BuildTree::default();
     }
-    let mut refs = vec![PrimRef::new(&Aabb::EMPTY, 0); n];
-    parallel::fill_indexed(&mut refs, 1 << 14, |i| PrimRef::new(&boxes[i], i as u32));
+    let mut refs = parallel::collect_indexed(n, 1 << 14, |i| PrimRef::new(&boxes[i], i as u32));
     let unused = BuildNode { bounds: Aabb::EMPTY, kind: BuildKind::Leaf { first: 0, count: 0 } };
-    let mut nodes = vec![unused; 2 * n - 1];
+    let mut nodes = parallel::collect_indexed(2 * n - 1, 1 << 14, |_| unused);
     build_parallel(splitter, &mut nodes, 0, &mut refs, 0, 0);
-    let mut prims = vec![0u32; n];
-    parallel::fill_indexed(&mut prims, 1 << 14, |i| refs[i].index());
+    let prims = parallel::collect_indexed(n, 1 << 14, |i| refs[i].index());
     BuildTree { nodes, prims, root: 0 }
 }
 
