@@ -16,7 +16,7 @@
 use glam::{BVec4A, IVec4, Vec3A, Vec4};
 
 use super::parallel;
-use super::top_down::{self, PIECE, PIECES_MIN, PrimRef, Splitter, partition_large, split_beats_leaf};
+use super::top_down::{self, PIECE, PIECES_MIN, PrimRef, Splitter, partition, partition_large, split_beats_leaf};
 use crate::Aabb;
 use crate::accel::bvh::{BuildTree, Bvh};
 
@@ -39,11 +39,17 @@ pub struct BinnedSah {
     /// default: every node is searched). For leaves whose primitives are tested several at once,
     /// as the triangle blocks of [`crate::TriangleBvh`] are, where splitting them gains nothing.
     pub small_leaf: usize,
+    /// Partitions ranges of [`PIECES_MIN`] references or more piece by piece, in parallel
+    /// (false by default). The sides are the same; the references' order within a side differs
+    /// from one pass's, which only the order within leaves (and so which primitive an any-hit
+    /// query tests first) and the count splits of coincident centroids see. The bounds and the
+    /// bins of large ranges are computed in pieces either way: their results are the same.
+    pub parallel_partition: bool,
 }
 
 impl Default for BinnedSah {
     fn default() -> Self {
-        BinnedSah { bins: MAX_BINS, max_leaf: DEFAULT_MAX_LEAF, small_leaf: 0 }
+        BinnedSah { bins: MAX_BINS, max_leaf: DEFAULT_MAX_LEAF, small_leaf: 0, parallel_partition: false }
     }
 }
 
@@ -308,7 +314,8 @@ impl Splitter for BinnedSah {
         }
         let plane = plane as f32;
         let (c_min, c_scale, c_plane) = (Vec4::from((c_min, 0.0)), Vec4::from((c_scale, 0.0)), Vec4::splat(plane));
-        Some(partition_large(refs, |r| past_plane(r.centroid4(), c_min, c_scale, c_plane) >> axis & 1 == 0))
+        let left = |r: &PrimRef| past_plane(r.centroid4(), c_min, c_scale, c_plane) >> axis & 1 == 0;
+        Some(if self.parallel_partition { partition_large(refs, left) } else { partition(refs, left) })
     }
 }
 
@@ -353,7 +360,7 @@ mod tests {
         let q = validate_bvh(&BinnedSah::default().build(&boxes), &boxes).unwrap();
         assert_eq!((q.leaves, q.max_leaf), (1, 8));
         // More than a leaf may hold: split anyway, into leaves no larger than allowed.
-        let builder = BinnedSah { bins: 8, max_leaf: 3, small_leaf: 0 };
+        let builder = BinnedSah { bins: 8, max_leaf: 3, small_leaf: 0, parallel_partition: false };
         let q = validate_bvh(&builder.build(&boxes), &boxes).unwrap();
         assert!(q.max_leaf <= 3 && q.leaves >= 3, "{q:?}");
     }
@@ -369,7 +376,11 @@ mod tests {
     fn bins_out_of_range_are_clamped() {
         let boxes: Vec<Aabb> = (0..100).map(|i| cube(Vec3::new(i as f32, 0.0, 0.0), 0.4)).collect();
         for bins in [0, 1, 2, 1000] {
-            validate_bvh(&BinnedSah { bins, max_leaf: 4, small_leaf: 0 }.build(&boxes), &boxes).unwrap();
+            validate_bvh(
+                &BinnedSah { bins, max_leaf: 4, small_leaf: 0, parallel_partition: false }.build(&boxes),
+                &boxes,
+            )
+            .unwrap();
         }
         assert_eq!(bin_of(f32::NAN, 0.0, 1.0, 8), 0);
         assert_eq!(bin_of(f32::INFINITY, 0.0, 1.0, 8), 7);
@@ -454,9 +465,14 @@ mod tests {
             }
         }
         assert_eq!(whole.counts[..k].iter().map(|c| c.x).sum::<i32>() as usize, refs.len());
-        // The tree over them, built with pieces at its top levels, is sound.
-        let q = validate_bvh(&BinnedSah::default().build(&boxes), &boxes).unwrap();
+        // The trees over them, built with pieces at their top levels, are sound, and the
+        // parallel partition's has the one pass's nodes (the same sides, their order aside).
+        let one_pass = BinnedSah::default().build(&boxes);
+        let q = validate_bvh(&one_pass, &boxes).unwrap();
         assert!(q.max_leaf <= DEFAULT_MAX_LEAF, "{q:?}");
+        let pieces = BinnedSah { parallel_partition: true, ..BinnedSah::default() }.build(&boxes);
+        assert_eq!(validate_bvh(&pieces, &boxes).unwrap(), q);
+        assert_eq!(pieces.sah_cost(), one_pass.sah_cost());
     }
 
     #[test]
@@ -465,7 +481,7 @@ mod tests {
         // Identical boxes: leaves of 8, split by count: 30 = 7 + 8 + 7 + 8.
         let bvh = BinnedSah::default().build(&boxes);
         assert_eq!(bvh.leaf_sizes(), [0, 0, 0, 0, 0, 0, 2, 2, 0]);
-        let one = BinnedSah { bins: 8, max_leaf: 30, small_leaf: 0 }.build(&boxes);
+        let one = BinnedSah { bins: 8, max_leaf: 30, small_leaf: 0, parallel_partition: false }.build(&boxes);
         assert_eq!(one.leaf_sizes(), [0, 0, 0, 0, 0, 0, 0, 0, 1]);
     }
 }

@@ -130,8 +130,10 @@ mod tests {
     #[test]
     fn better_than_few_bins() {
         let boxes = cloud(3000);
-        let (sweep, binned) =
-            (SweepSah::default().build(&boxes), BinnedSah { bins: 4, max_leaf: 8, small_leaf: 0 }.build(&boxes));
+        let (sweep, binned) = (
+            SweepSah::default().build(&boxes),
+            BinnedSah { bins: 4, max_leaf: 8, ..BinnedSah::default() }.build(&boxes),
+        );
         assert!(sweep.sah_cost() < binned.sah_cost(), "{} vs {}", sweep.sah_cost(), binned.sah_cost());
     }
 
