@@ -129,8 +129,9 @@ const PARALLEL_MIN: usize = 4096;
 /// [`PARALLEL_MIN`] references, the explicit work stack takes over.
 const PARALLEL_DEPTH: u32 = 40;
 
-/// Ranges of at least this many references are bounded, binned and partitioned in pieces of
-/// [`PIECE`] references, the pieces in parallel. Above it the two halves of a node cannot keep
+/// Ranges of at least this many references are bounded and binned in pieces of [`PIECE`]
+/// references, the pieces in parallel, and partitioned in pieces where the splitter asks for it
+/// ([`partition_large`]; `BinnedSah::parallel_partition`). Above it the two halves of a node cannot keep
 /// the cores busy on their own: the root's passes would run on one core, and so would each node
 /// along a chain of uneven splits, whose passes add up to several times the root's.
 pub const PIECES_MIN: usize = 1 << 15;
