@@ -406,15 +406,21 @@ mod tests {
         }
     }
 
-    #[test]
-    fn the_three_lane_areas_are_the_one_box_areas_bit_for_bit() {
-        let mut state = 0x2545_f491_u32;
-        let mut next = move || {
+    /// Floats spread over `0..1` from `seed` (a xorshift generator: the tests need no more).
+    fn unit_floats(seed: u32) -> impl FnMut() -> f32 {
+        let mut state = seed;
+        move || {
             state ^= state << 13;
             state ^= state >> 17;
             state ^= state << 5;
-            (state >> 8) as f32 / (1 << 24) as f32 * 200.0 - 100.0
-        };
+            (state >> 8) as f32 / (1 << 24) as f32
+        }
+    }
+
+    #[test]
+    fn the_three_lane_areas_are_the_one_box_areas_bit_for_bit() {
+        let mut unit = unit_floats(0x2545_f491);
+        let mut next = move || unit() * 200.0 - 100.0;
         for _ in 0..1000 {
             let sides = [0, 1, 2].map(|_| {
                 let (a, b) = (Vec3A::new(next(), next(), next()), Vec3A::new(next(), next(), next()));
@@ -435,13 +441,8 @@ mod tests {
 
     #[test]
     fn a_large_range_binned_in_pieces_fills_the_bins_of_one_pass() {
-        let mut state = 0x9e37_79b9_u32;
-        let mut next = move || {
-            state ^= state << 13;
-            state ^= state >> 17;
-            state ^= state << 5;
-            (state >> 8) as f32 / (1 << 24) as f32 * 100.0
-        };
+        let mut unit = unit_floats(0x9e37_79b9);
+        let mut next = move || unit() * 100.0;
         let boxes: Vec<Aabb> = (0..PIECES_MIN + 3 * PIECE / 2)
             .map(|_| cube(Vec3::new(next(), next(), next() * 0.1), next() * 0.01))
             .collect();

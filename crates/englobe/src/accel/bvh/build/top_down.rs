@@ -131,9 +131,10 @@ const PARALLEL_DEPTH: u32 = 40;
 
 /// Ranges of at least this many references are bounded and binned in pieces of [`PIECE`]
 /// references, the pieces in parallel, and partitioned in pieces where the splitter asks for it
-/// ([`partition_large`]; `BinnedSah::parallel_partition`). Above it the two halves of a node cannot keep
-/// the cores busy on their own: the root's passes would run on one core, and so would each node
-/// along a chain of uneven splits, whose passes add up to several times the root's.
+/// ([`partition_large`]; `BinnedSah::parallel_partition`). Above it the two halves of a node
+/// cannot keep the cores busy on their own: the root's passes would run on one core, and so
+/// would each node along a chain of uneven splits, whose passes add up to several times the
+/// root's.
 pub const PIECES_MIN: usize = 1 << 15;
 /// References per piece of a large range (see [`PIECES_MIN`]): a fixed size, so that the pieces,
 /// and hence the partition's order, never depend on the threads.
