@@ -27,10 +27,10 @@
 //! that list triangles report each once.
 
 use glam::Vec3;
-use rayon::prelude::*;
 
 use crate::Aabb;
 use crate::accel::MAX_PRIMITIVES;
+use crate::accel::bvh::build::parallel::collect_indexed;
 use crate::shapes::clip::Polygon;
 
 /// Most pieces one triangle is cut into.
@@ -65,8 +65,7 @@ pub fn presplit(boxes: &[Aabb], triangle: impl Fn(u32) -> [Vec3; 3] + Sync, budg
         return whole();
     }
     let scene = boxes.iter().fold(Aabb::EMPTY, |s, b| s.union(b));
-    let waste: Vec<f32> =
-        (0..count as u32).into_par_iter().map(|i| wasted_area(&triangle(i), &boxes[i as usize])).collect();
+    let waste: Vec<f32> = collect_indexed(count, 1 << 12, |i| wasted_area(&triangle(i as u32), &boxes[i]));
     let total: f64 = waste.iter().map(|&w| w as f64).sum();
     if !(total > 0.0) || !scene.is_finite() {
         return whole();
@@ -74,14 +73,12 @@ pub fn presplit(boxes: &[Aabb], triangle: impl Fn(u32) -> [Vec3; 3] + Sync, budg
     let share = extra as f64 / total;
     let pieces = |i: usize| (1 + (waste[i] as f64 * share) as usize).min(MAX_PIECES);
     let cut_ones: Vec<u32> = (0..count as u32).filter(|&i| pieces(i as usize) > 1).collect();
-    let cut_boxes: Vec<Vec<Aabb>> = cut_ones
-        .par_iter()
-        .map(|&i| {
-            let mut out = Vec::with_capacity(pieces(i as usize));
-            cut(&Polygon::triangle(triangle(i)), boxes[i as usize], pieces(i as usize), &scene, &mut out);
-            out
-        })
-        .collect();
+    let cut_boxes: Vec<Vec<Aabb>> = collect_indexed(cut_ones.len(), 64, |k| {
+        let i = cut_ones[k];
+        let mut out = Vec::with_capacity(pieces(i as usize));
+        cut(&Polygon::triangle(triangle(i)), boxes[i as usize], pieces(i as usize), &scene, &mut out);
+        out
+    });
     let mut out = Fragments { boxes: Vec::with_capacity(count + extra), owner: Vec::with_capacity(count + extra) };
     let mut next_cut = cut_ones.iter().zip(&cut_boxes).peekable();
     for (i, b) in boxes.iter().enumerate() {
