@@ -209,8 +209,8 @@ fn weighted_areas(sides: &[Bin; 3], counts: IVec4) -> (Vec4, Vec4) {
     let e = sides.map(|b| b.max - b.min);
     let lanes = |f: fn(Vec3A) -> f32| Vec4::new(f(e[0]), f(e[1]), f(e[2]), 0.0);
     let (ex, ey, ez) = (lanes(|v| v.x), lanes(|v| v.y), lanes(|v| v.z));
-    // Exact conversions: a count below 2^31 is the same float whether converted from an `i32`
-    // or from the `u32` it would otherwise be.
+    // A count below 2^31 converts to the same float from an `i32` as from the `u32` it would
+    // otherwise be (rounded alike above 2^24).
     let count = counts.as_vec4();
     (Vec4::splat(2.0) * (ex * ey + ey * ez + ez * ex) * count, count)
 }
