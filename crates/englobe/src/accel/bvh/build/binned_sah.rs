@@ -290,9 +290,8 @@ impl Splitter for BinnedSah {
         // cannot be split fills its first bin, which no plane reads).
         let (c_min, c_scale) = (Vec3A::from(min), Vec3A::from_array(scale));
         let place = Placement { min: c_min, scale: c_scale, last: Vec3A::splat((k - 1) as f32), k };
-        let bins = if refs.len() < PIECES_MIN {
+        if refs.len() < PIECES_MIN {
             place.bin(refs, scratch);
-            scratch
         } else {
             // Large ranges in pieces, in parallel; merged, their bins are the ones one pass
             // would fill (unions and sums, exact in any order).
@@ -305,10 +304,9 @@ impl Splitter for BinnedSah {
             for piece in &pieces {
                 scratch.merge(piece, k);
             }
-            scratch
-        };
+        }
 
-        let (weighted, axis, plane) = best_plane(bins, k, scale.map(|s| s > 0.0))?;
+        let (weighted, axis, plane) = best_plane(scratch, k, scale.map(|s| s > 0.0))?;
         if !must_split && !split_beats_leaf(weighted, bounds.surface_area(), refs.len()) {
             return None;
         }
