@@ -88,7 +88,9 @@ impl AccelKind {
             AccelKind::BvhSeedOrdered => {
                 "the seed report's BVH, traversed nearer child first with t_max shrinking at each hit"
             }
-            AccelKind::BvhSah => "binary BVH built top-down with the binned surface area heuristic (32 bins per axis)",
+            AccelKind::BvhSah => {
+                "binary BVH built top-down with the binned surface area heuristic (up to 32 bins per axis)"
+            }
             AccelKind::BvhPloc => {
                 "binary BVH built bottom-up by parallel locally-ordered clustering, treelets restructured, leaves collapsed by the SAH"
             }

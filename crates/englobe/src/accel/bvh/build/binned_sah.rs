@@ -3,7 +3,9 @@
 //! `BVHAggregate` builds with buckets (Pharr, Jakob and Humphreys, "Physically Based Rendering",
 //! 4th ed. 2023, section 7.3.2).
 //!
-//! At each node the centroids' box is cut into [`BinnedSah::bins`] equal slabs along each axis,
+//! At each node the centroids' box is cut into [`BinnedSah::bins`] equal slabs along each axis
+//! (fewer in small nodes, as Embree's binner cuts them: Wald, Woop, Benthin, Johnson and Ernst
+//! 2014, "Embree: A Kernel Framework for Efficient CPU Ray Tracing"),
 //! every primitive is dropped into the slab of its centroid (one pass for all three axes), and the
 //! planes between slabs are scored with the SAH from the slabs' boxes and counts, swept once from
 //! each side. The best plane of the three axes is taken if it costs less than a leaf (or if the
@@ -30,8 +32,9 @@ pub const DEFAULT_MAX_LEAF: usize = 8;
 /// The binned SAH builder. `BinnedSah::default()` uses 32 bins and leaves of at most 8 primitives.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct BinnedSah {
-    /// Bins per axis, 2 to [`MAX_BINS`] (values outside are clamped). More bins find better
-    /// planes at the same linear cost per node.
+    /// Most bins per axis, 2 to [`MAX_BINS`] (values outside are clamped); a node over `n`
+    /// primitives uses at most `4 + n / 20` of them. More bins find better planes at the same
+    /// linear cost per node.
     pub bins: usize,
     /// Most primitives per leaf (at least 1).
     pub max_leaf: usize,
@@ -76,7 +79,8 @@ struct Bin {
 const EMPTY_BIN: Bin = Bin { min: Vec3A::INFINITY, max: Vec3A::NEG_INFINITY };
 
 /// The bins of the three axes, kept by each thread from node to node: a node clears only the
-/// bins it uses (8 of the 32 in small nodes) instead of copying a fresh 3.5 KiB array.
+/// bins it uses (4 to 7 of the 32 in nodes under 80 references) instead of copying a fresh
+/// 3.5 KiB array.
 #[derive(Clone, Debug)]
 pub struct Bins {
     boxes: [[Bin; MAX_BINS]; 3],
@@ -273,12 +277,14 @@ impl Splitter for BinnedSah {
         must_split: bool,
         scratch: &mut Bins,
     ) -> Option<usize> {
-        // A node over few primitives gets about as many bins as it has primitives (at least
-        // eight): more would mostly sweep empty bins, and the sweep is the cost of small nodes.
+        // A node over `n` primitives gets at most `4 + n / 20` bins, as Embree's binner gives
+        // them (`BinMapping`): in small nodes the sweep over the bins, not the binning, is the
+        // cost, and fewer bins there lose little (on the bunny and the Sponza, 8-9 % fewer
+        // instructions per triangle built, within 1 % more per ray; docs/performance.md).
         if !must_split && refs.len() <= self.small_leaf {
             return None;
         }
-        let k = self.bins.clamp(2, MAX_BINS).min(refs.len().max(8));
+        let k = self.bins.clamp(2, MAX_BINS).min(4 + refs.len() / 20);
         let extent = centroid_bounds.extent();
         // Axes along which the centroids spread; the others cannot be split by a plane.
         let scale = extent.to_array().map(|e| if e > 0.0 { k as f32 / e } else { 0.0 });
