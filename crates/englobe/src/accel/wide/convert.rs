@@ -18,8 +18,8 @@
 //! the interior children of a node are stored next to one another, in slot order.
 //!
 //! The binary tree is read through [`BinaryTree`] (the laid-out `Bvh` of any builder, or the
-//! top-down builders' `BuildTree` as it comes out of the build). A large tree's subtrees below the
-//! root are converted in parallel (see [`convert`]).
+//! top-down builders' `BuildTree` as it comes out of the build). A large tree's subtrees are
+//! converted in parallel (see [`convert`]).
 
 pub use super::binary::BinaryTree;
 use super::node::{EMPTY, LEAF, MAX_LEAF_ITEMS, WIDTH, WideNode, index_of, is_leaf};
@@ -75,15 +75,18 @@ enum Part {
     },
 }
 
-/// Trees over at least this many primitives convert the subtrees under the root in parallel.
+/// Subtrees over at least this many primitives convert their children's subtrees in parallel.
 const PARALLEL_MIN: u32 = 1 << 14;
+
+/// Wide levels below which subtrees are converted in parallel (up to 8^4 subtrees: plenty of work
+/// for every core).
+const PARALLEL_LEVELS: u32 = 4;
 
 /// Converts `tree` into wide nodes, its leaves stored through `sink`.
 ///
-/// A large tree's root node is made first; the subtrees of its interior children are then
-/// converted in parallel, each into nodes and items of its own, and appended in slot order (their
-/// references moved past the nodes and items before them). The tree is the one a single walk
-/// makes; only the order in which nodes and items are stored differs (each subtree's together).
+/// A large tree is converted in parallel, subtree by subtree (`Walker::convert`). The tree is the
+/// one a single walk makes; only the order in which nodes and items are stored differs (each large
+/// subtree's together).
 pub fn convert<T, S>(tree: &T, options: ConvertOptions, sink: &mut S) -> WideLayout
 where
     T: BinaryTree + Sync,
@@ -92,35 +95,7 @@ where
     let Some(root) = tree.root() else {
         return WideLayout::default();
     };
-    let walker = Walker::new(tree, options, sink.max_prims());
-    if walker.count[root as usize] < PARALLEL_MIN {
-        return walker.walk(Part::Node(root), sink);
-    }
-    let mut scratch = Scratch::default();
-    // The root's interior children are placed once their subtrees are converted.
-    let mut subtrees = Vec::new();
-    let mut node = walker.node(Part::Node(root), sink, &mut scratch, |slot, p| {
-        subtrees.push((slot, p));
-        0
-    });
-    let mut converted: Vec<Option<(WideLayout, S)>> = subtrees.iter().map(|_| None).collect();
-    let template = &*sink;
-    fill_indexed(&mut converted, 1, |i| {
-        let mut items = template.split();
-        Some((walker.walk(subtrees[i].1, &mut items), items))
-    });
-    let mut nodes = vec![WideNode::EMPTY_NODE];
-    let mut depth = 1;
-    for (&(slot, _), done) in subtrees.iter().zip(converted) {
-        let (layout, items) = done.expect("every subtree is converted");
-        let first_node = nodes.len() as u32;
-        let first_item = sink.join(items);
-        node.children[slot] = first_node;
-        nodes.extend(layout.nodes.into_iter().map(|n| relocate(n, first_node, first_item)));
-        depth = depth.max(1 + layout.depth);
-    }
-    nodes[0] = node;
-    WideLayout { nodes, depth }
+    Walker::new(tree, options, sink.max_prims()).convert(Part::Node(root), sink, PARALLEL_LEVELS)
 }
 
 /// `node` moved `nodes` nodes and `items` leaf items further: its references follow.
@@ -264,6 +239,47 @@ impl<'a, T: BinaryTree> Walker<'a, T> {
             }
         }
         node
+    }
+
+    /// The wide subtree standing for `part` (its root is node 0), its leaves stored through
+    /// `sink`. A part over [`PARALLEL_MIN`] primitives or more has its node made first; the
+    /// subtrees of its interior children are then converted in parallel, each the same way into
+    /// nodes and items of its own, and appended in slot order (their references moved past the
+    /// nodes and items before them), down to `levels` wide levels. Recursing, rather than
+    /// splitting at the root alone, keeps the cores busy when the root's subtrees are uneven; the
+    /// bound keeps a degenerate tree (a chain as deep as it has primitives) off the call stack.
+    fn convert<S: LeafSink + Send + Sync>(&self, part: Part, sink: &mut S, levels: u32) -> WideLayout
+    where
+        T: Sync,
+    {
+        if levels == 0 || self.prims_in(&part) < PARALLEL_MIN {
+            return self.walk(part, sink);
+        }
+        let mut scratch = Scratch::default();
+        // The interior children are placed once their subtrees are converted.
+        let mut subtrees = Vec::new();
+        let mut node = self.node(part, sink, &mut scratch, |slot, p| {
+            subtrees.push((slot, p));
+            0
+        });
+        let mut converted: Vec<Option<(WideLayout, S)>> = subtrees.iter().map(|_| None).collect();
+        let template = &*sink;
+        fill_indexed(&mut converted, 1, |i| {
+            let mut items = template.split();
+            Some((self.convert(subtrees[i].1, &mut items, levels - 1), items))
+        });
+        let mut nodes = vec![WideNode::EMPTY_NODE];
+        let mut depth = 1;
+        for (&(slot, _), done) in subtrees.iter().zip(converted) {
+            let (layout, items) = done.expect("every subtree is converted");
+            let first_node = nodes.len() as u32;
+            let first_item = sink.join(items);
+            node.children[slot] = first_node;
+            nodes.extend(layout.nodes.into_iter().map(|n| relocate(n, first_node, first_item)));
+            depth = depth.max(1 + layout.depth);
+        }
+        nodes[0] = node;
+        WideLayout { nodes, depth }
     }
 
     /// The wide subtree standing for `part` (its root is node 0), in one walk.
@@ -473,7 +489,9 @@ mod tests {
 
     #[test]
     fn large_trees_convert_their_subtrees_in_parallel_into_the_same_tree() {
-        let n = 3 * PARALLEL_MIN as usize;
+        // The root has at most eight children, so one of them is over `n / 8`, above
+        // `PARALLEL_MIN`: its own subtrees are converted in parallel too.
+        let n = 10 * PARALLEL_MIN as usize;
         let boxes = grid(n);
         let tree = BinnedSah::default().build_tree(&boxes);
         for collapse in [0, 4] {
