@@ -24,7 +24,7 @@
 pub use super::binary::BinaryTree;
 use super::node::{EMPTY, LEAF, MAX_LEAF_ITEMS, WIDTH, WideNode, index_of, is_leaf};
 use crate::Aabb;
-use crate::accel::bvh::build::parallel::fill_indexed;
+use crate::accel::bvh::build::parallel::collect_indexed;
 
 /// Where the leaves of a conversion go.
 pub trait LeafSink {
@@ -262,16 +262,14 @@ impl<'a, T: BinaryTree> Walker<'a, T> {
             subtrees.push((slot, p));
             0
         });
-        let mut converted: Vec<Option<(WideLayout, S)>> = subtrees.iter().map(|_| None).collect();
         let template = &*sink;
-        fill_indexed(&mut converted, 1, |i| {
+        let converted = collect_indexed(subtrees.len(), 1, |i| {
             let mut items = template.split();
-            Some((self.convert(subtrees[i].1, &mut items, levels - 1), items))
+            (self.convert(subtrees[i].1, &mut items, levels - 1), items)
         });
         let mut nodes = vec![WideNode::EMPTY_NODE];
         let mut depth = 1;
-        for (&(slot, _), done) in subtrees.iter().zip(converted) {
-            let (layout, items) = done.expect("every subtree is converted");
+        for (&(slot, _), (layout, items)) in subtrees.iter().zip(converted) {
             let first_node = nodes.len() as u32;
             let first_item = sink.join(items);
             node.children[slot] = first_node;
@@ -496,12 +494,16 @@ mod tests {
         let tree = BinnedSah::default().build_tree(&boxes);
         for collapse in [0, 4] {
             let options = ConvertOptions { collapse };
+            let walker = Walker::new(&tree, options, 8);
+            let mut slots = Vec::new();
+            walker.fill_slots(Part::Node(tree.root), &mut slots);
+            assert!(slots.iter().any(|p| !walker.terminal(p) && walker.prims_in(p) >= PARALLEL_MIN));
             let mut sink = Refs { max: 8, refs: Vec::new() };
             let layout = convert(&tree, options, &mut sink);
             assert_eq!(check(&layout, &sink.refs, &boxes), layout.depth);
             // One walk over the whole tree: the same nodes, depth and leaves.
             let mut alone = Refs { max: 8, refs: Vec::new() };
-            let walked = Walker::new(&tree, options, 8).walk(Part::Node(tree.root), &mut alone);
+            let walked = walker.walk(Part::Node(tree.root), &mut alone);
             assert_eq!((layout.nodes.len(), layout.depth), (walked.nodes.len(), walked.depth));
             assert_eq!(shape(&layout, &sink.refs), shape(&walked, &alone.refs));
             assert!(layout.nodes[0].children.iter().filter(|&&c| c != EMPTY && !is_leaf(c)).count() > 1);
