@@ -13,7 +13,14 @@
 //! * **Which triangles.** Each triangle's priority is the surface area its box wastes: the box's
 //!   area less the area the triangle's own projections cover. A budget of extra references (a
 //!   fraction of the triangle count) is shared out in proportion to priority, so only the worst
-//!   triangles are split, each into at most [`MAX_PIECES`] pieces.
+//!   triangles are split, each into at most [`MAX_PIECES`] pieces. A triangle is a candidate only
+//!   if its box wastes at least [`MIN_WASTE_SHARE`] of the scene box's area: a triangle small
+//!   against the scene sits in small nodes, among neighbours whose boxes cover what its own box
+//!   wastes, and cutting it costs the build a reference for nothing a ray would notice. On the
+//!   ogre (an even mesh of 124 000 triangles) the budget made 16.4 % more references without
+//!   that floor, 0.1 % with it: the build runs 25 % fewer instructions and the rays -1 % to +2 %
+//!   more. The Sponza keeps nearly all its cuts (14.5 % more references instead of 14.9 %): its
+//!   walls and floors are large against the atrium.
 //! * **Where to cut.** A piece is cut across the longest axis of its box, at the coarsest plane
 //!   of a power-of-two grid over the scene's box that crosses it: the planes a top-down build is
 //!   likely to split at, so that pieces fall cleanly on both sides of nodes (Karras and Aila's
@@ -36,6 +43,11 @@ use crate::shapes::clip::Polygon;
 /// Most pieces one triangle is cut into.
 pub const MAX_PIECES: usize = 16;
 
+/// The least area a triangle's box must waste, as a share of the scene box's surface area, for
+/// the triangle to be cut (a box wasting 1/2048 of the scene's area: a square about 1/45 of the
+/// scene's side). Chosen on the bunny, the ogre and the Sponza: see the module's documentation.
+pub const MIN_WASTE_SHARE: f32 = 1.0 / 2048.0;
+
 /// The boxes the build sees and, for each, the triangle (an index into the caller's list) it
 /// belongs to.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -54,7 +66,8 @@ fn wasted_area(v: &[Vec3; 3], b: &Aabb) -> f32 {
 }
 
 /// Cuts triangles `triangle(i)` for `i` in `0..count` (each of box `boxes[i]`, finite and not
-/// empty) into fragments, with at most `budget * count` fragments more than triangles. The
+/// empty) into fragments, with at most `budget * count` fragments more than triangles; only the
+/// triangles whose boxes waste at least [`MIN_WASTE_SHARE`] of the scene's area are cut. The
 /// triangles are cut in parallel; the fragments come in triangle order, whatever the threads.
 pub fn presplit(boxes: &[Aabb], triangle: impl Fn(u32) -> [Vec3; 3] + Sync, budget: f32) -> Fragments {
     let count = boxes.len();
@@ -70,8 +83,13 @@ pub fn presplit(boxes: &[Aabb], triangle: impl Fn(u32) -> [Vec3; 3] + Sync, budg
     if !(total > 0.0) || !scene.is_finite() {
         return whole();
     }
+    // The budget is shared in proportion to every triangle's waste; those below the floor take
+    // no part of it.
     let share = extra as f64 / total;
-    let pieces = |i: usize| (1 + (waste[i] as f64 * share) as usize).min(MAX_PIECES);
+    let floor = scene.surface_area() * MIN_WASTE_SHARE;
+    let pieces = |i: usize| {
+        if waste[i] < floor { 1 } else { (1 + (waste[i] as f64 * share) as usize).min(MAX_PIECES) }
+    };
     let cut_ones: Vec<u32> = (0..count as u32).filter(|&i| pieces(i as usize) > 1).collect();
     let cut_boxes: Vec<Vec<Aabb>> = collect_indexed(cut_ones.len(), 64, |k| {
         let i = cut_ones[k];
@@ -187,6 +205,36 @@ mod tests {
         }
         // The small triangles are left whole.
         assert!((0..50u32).all(|i| f.owner.iter().filter(|&&o| o == i).count() == 1));
+    }
+
+    #[test]
+    fn triangles_small_against_the_scene_are_never_cut() {
+        // A 100 x 100 grid of unit triangles, one in four thin and diagonal (its box wastes 4.68,
+        // the others' nothing): the budget alone would cut each diagonal one in two (4.68 times
+        // 4 000 extra over 2 500 x 4.68 of waste), but none wastes 1/2048 of the scene's area.
+        let grid = |k: usize| Vec3::new((k % 100) as f32, (k / 100) as f32, 0.0);
+        let mut tris: Vec<[Vec3; 3]> = (0..10_000)
+            .map(|k| {
+                let o = grid(k);
+                if k % 4 == 0 {
+                    [o, o + Vec3::new(0.9, 0.9, 0.9), o + Vec3::new(0.9, 0.8, 0.9)]
+                } else {
+                    [o, o + Vec3::new(0.9, 0.0, 0.0), o + Vec3::new(0.0, 0.9, 0.0)]
+                }
+            })
+            .collect();
+        let boxes: Vec<Aabb> = tris.iter().map(|t| Aabb::from_points(*t)).collect();
+        let waste = wasted_area(&tris[0], &boxes[0]);
+        assert!(waste * 4_000.0 / (2_500.0 * waste) >= 1.0 && waste > 4.0);
+        let f = presplit(&boxes, |i| tris[i as usize], 0.4);
+        assert_eq!(f.boxes, boxes);
+        // The same triangle grown to a fifth of the scene is cut.
+        tris[0] = [Vec3::ZERO, Vec3::splat(20.0), Vec3::new(20.0, 18.0, 20.0)];
+        let boxes: Vec<Aabb> = tris.iter().map(|t| Aabb::from_points(*t)).collect();
+        let f = presplit(&boxes, |i| tris[i as usize], 0.4);
+        let pieces = f.owner.iter().filter(|&&o| o == 0).count();
+        assert!(pieces > 1, "{pieces} pieces");
+        assert!(f.owner[pieces..].iter().copied().eq(1..10_000));
     }
 
     #[test]
