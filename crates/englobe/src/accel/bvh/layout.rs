@@ -26,7 +26,19 @@ pub enum BuildKind {
     Interior {
         /// The first and second child.
         children: [u32; 2],
+        /// Primitive references under the node: the sum of its children's (what the conversion
+        /// to wide nodes reads to decide where leaves go, without counting them first).
+        count: u32,
     },
+}
+
+impl BuildNode {
+    /// Primitive references under the node: a leaf's count, an interior node's recorded count.
+    pub fn prims_under(&self) -> u32 {
+        match self.kind {
+            BuildKind::Leaf { count, .. } | BuildKind::Interior { count, .. } => count,
+        }
+    }
 }
 
 /// A node of a [`BuildTree`].
@@ -54,8 +66,9 @@ impl BuildTree {
     /// Lays the tree out depth-first: each interior node is followed by its first child's subtree,
     /// then its second child's; leaves' references are copied in the same order.
     ///
-    /// The tree is trusted to be a tree (every node reachable once from the root); builders
-    /// guarantee it and the validator checks the result.
+    /// The tree is trusted to be a tree (every node reachable once from the root, each interior
+    /// node's count the sum of its children's); builders guarantee it and the validator checks
+    /// the result.
     pub fn into_bvh(self) -> Bvh {
         if self.nodes.is_empty() {
             return Bvh::empty();
@@ -79,7 +92,7 @@ impl BuildTree {
                     nodes.push(BvhNode::leaf(node.bounds, prim_indices.len() as u32, count));
                     prim_indices.extend_from_slice(&self.prims[range]);
                 }
-                BuildKind::Interior { children: [first, second] } => {
+                BuildKind::Interior { children: [first, second], .. } => {
                     let (axis, second_is_lower) =
                         order_axis(&self.nodes[first as usize].bounds, &self.nodes[second as usize].bounds);
                     // The second child's index is patched in when it is laid out.
@@ -130,8 +143,14 @@ mod tests {
                 BuildNode { bounds: unit_at(0.0), kind: BuildKind::Leaf { first: 0, count: 1 } },
                 BuildNode { bounds: unit_at(1.0), kind: BuildKind::Leaf { first: 1, count: 1 } },
                 BuildNode { bounds: unit_at(2.0), kind: BuildKind::Leaf { first: 2, count: 2 } },
-                BuildNode { bounds: unit_at(0.0).union(&unit_at(1.0)), kind: BuildKind::Interior { children: [0, 1] } },
-                BuildNode { bounds: unit_at(0.0).union(&unit_at(2.0)), kind: BuildKind::Interior { children: [3, 2] } },
+                BuildNode {
+                    bounds: unit_at(0.0).union(&unit_at(1.0)),
+                    kind: BuildKind::Interior { children: [0, 1], count: 2 },
+                },
+                BuildNode {
+                    bounds: unit_at(0.0).union(&unit_at(2.0)),
+                    kind: BuildKind::Interior { children: [3, 2], count: 4 },
+                },
             ],
             prims: vec![7, 5, 6, 4],
             root: 4,
@@ -148,6 +167,58 @@ mod tests {
         assert_eq!(bvh.prim_indices(), &[7, 5, 6, 4]);
     }
 
+    /// Whether every node reachable from the root records the primitives under it.
+    fn counts_agree(tree: &BuildTree) -> bool {
+        let mut under = vec![None; tree.nodes.len()];
+        let mut stack = vec![(tree.root, false)];
+        while let Some((id, children_done)) = stack.pop() {
+            let node = &tree.nodes[id as usize];
+            match node.kind {
+                BuildKind::Leaf { count, .. } => under[id as usize] = Some(count),
+                BuildKind::Interior { children: [a, b], .. } if children_done => {
+                    under[id as usize] = under[a as usize].zip(under[b as usize]).map(|(x, y)| x + y);
+                }
+                BuildKind::Interior { children: [a, b], .. } => stack.extend([(id, true), (a, false), (b, false)]),
+            }
+        }
+        under[tree.root as usize] == Some(tree.prims.len() as u32)
+            && tree.nodes.iter().zip(&under).all(|(n, u)| u.is_none_or(|u| u == n.prims_under()))
+    }
+
+    #[test]
+    fn every_builder_records_the_primitives_under_each_node() {
+        use crate::accel::bvh::build::{collapse::collapse_leaves, treelet::restructure};
+        use crate::accel::bvh::{BinnedSah, Ploc, SweepSah};
+        use crate::accel::reference::SeedPairing;
+        // Boxes in a pseudo-random cloud, enough for the parallel builds.
+        let boxes: Vec<Aabb> = (0..40_000u32)
+            .map(|i| {
+                let h = |k: u32| (i.wrapping_mul(2_654_435_761).wrapping_add(k.wrapping_mul(40_503)) % 10_007) as f32;
+                let p = Vec3::new(h(1), h(2), h(3)) * 0.01;
+                Aabb::new(p, p + Vec3::splat(0.05 + h(4) * 1e-5))
+            })
+            .collect();
+        let trees = [
+            BinnedSah::default().build_tree(&boxes),
+            SweepSah::default().build_tree(&boxes[..3_000]),
+            Ploc::default().build_tree(&boxes),
+            SeedPairing::build_tree(&boxes[..3_000]),
+        ];
+        for tree in trees {
+            assert!(counts_agree(&tree));
+            assert!(counts_agree(&collapse_leaves(&tree, 4)));
+            let mut restructured = tree.clone();
+            restructure(&mut restructured, 4, 1);
+            assert!(counts_agree(&restructured));
+        }
+        // A count that is not its children's sum is caught.
+        let mut tree = BinnedSah::default().build_tree(&boxes[..100]);
+        if let BuildKind::Interior { count, .. } = &mut tree.nodes[tree.root as usize].kind {
+            *count += 1;
+        }
+        assert!(!counts_agree(&tree));
+    }
+
     #[test]
     fn a_deep_chain_is_laid_out_without_recursion() {
         // A chain 100 000 deep: interior i has children (leaf i, interior i + 1).
@@ -158,7 +229,10 @@ mod tests {
         }
         for i in 0..n - 1 {
             let next = if i + 1 == n - 1 { n - 1 } else { n + i + 1 };
-            nodes.push(BuildNode { bounds: unit_at(0.0), kind: BuildKind::Interior { children: [next, i] } });
+            nodes.push(BuildNode {
+                bounds: unit_at(0.0),
+                kind: BuildKind::Interior { children: [next, i], count: n - i },
+            });
         }
         let tree = BuildTree { nodes, prims: (0..n).collect(), root: n };
         let bvh = tree.into_bvh();
@@ -181,7 +255,7 @@ mod tests {
             nodes: vec![
                 BuildNode { bounds: b, kind: BuildKind::Leaf { first: 0, count: 1 } },
                 BuildNode { bounds: a, kind: BuildKind::Leaf { first: 1, count: 1 } },
-                BuildNode { bounds: a.union(&b), kind: BuildKind::Interior { children: [0, 1] } },
+                BuildNode { bounds: a.union(&b), kind: BuildKind::Interior { children: [0, 1], count: 2 } },
             ],
             prims: vec![0, 1],
             root: 2,

@@ -301,7 +301,7 @@ mod tests {
         let all = nodes.iter().fold(Aabb::EMPTY, |a, b| a.union(&b.bounds));
         for i in 0..n - 1 {
             let next = if i + 1 == n - 1 { n - 1 } else { n + i + 1 };
-            nodes.push(BuildNode { bounds: all, kind: BuildKind::Interior { children: [i, next] } });
+            nodes.push(BuildNode { bounds: all, kind: BuildKind::Interior { children: [i, next], count: n - i } });
         }
         let bvh = BuildTree { nodes, prims: (0..n).collect(), root: n }.into_bvh();
         assert!(bvh.depth() as usize > INLINE_STACK);

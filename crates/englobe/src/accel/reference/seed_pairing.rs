@@ -59,7 +59,8 @@ impl SeedPairing {
                     [left, right] => {
                         let bounds = nodes[left as usize].bounds.union(&nodes[right as usize].bounds);
                         parents.push(nodes.len() as u32);
-                        nodes.push(BuildNode { bounds, kind: BuildKind::Interior { children: [left, right] } });
+                        let count = nodes[left as usize].prims_under() + nodes[right as usize].prims_under();
+                        nodes.push(BuildNode { bounds, kind: BuildKind::Interior { children: [left, right], count } });
                     }
                     // The odd one out goes up alone.
                     [alone] => parents.push(alone),
@@ -108,7 +109,7 @@ mod tests {
         let tree = SeedPairing::build_tree(&boxes);
         assert_eq!(tree.nodes.len(), 9);
         let root = tree.nodes[tree.root as usize];
-        let BuildKind::Interior { children: [left, right] } = root.kind else { panic!("the root is interior") };
+        let BuildKind::Interior { children: [left, right], .. } = root.kind else { panic!("the root is interior") };
         assert_eq!(right, 4, "leaf 4 went up alone to pair with the root's left subtree");
         assert_eq!(tree.nodes[left as usize].bounds, boxes[0].union(&boxes[3]));
         let bvh = tree.into_bvh();

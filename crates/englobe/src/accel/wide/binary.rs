@@ -21,6 +21,9 @@ pub trait BinaryTree {
     fn leaf_range(&self, node: u32) -> Range<usize>;
     /// The primitive references the leaves' ranges index.
     fn prims(&self) -> &[u32];
+    /// Primitive references under a node, if the tree records them; otherwise the conversion
+    /// counts them in a walk of its own first.
+    fn prims_under(&self, node: u32) -> Option<u32>;
 }
 
 impl BinaryTree for Bvh {
@@ -43,6 +46,9 @@ impl BinaryTree for Bvh {
     fn prims(&self) -> &[u32] {
         self.prim_indices()
     }
+    fn prims_under(&self, _: u32) -> Option<u32> {
+        None
+    }
 }
 
 impl BinaryTree for BuildTree {
@@ -57,7 +63,7 @@ impl BinaryTree for BuildTree {
     }
     fn children(&self, node: u32) -> Option<[u32; 2]> {
         match self.nodes[node as usize].kind {
-            BuildKind::Interior { children } => Some(children),
+            BuildKind::Interior { children, .. } => Some(children),
             BuildKind::Leaf { .. } => None,
         }
     }
@@ -69,5 +75,8 @@ impl BinaryTree for BuildTree {
     }
     fn prims(&self) -> &[u32] {
         &self.prims
+    }
+    fn prims_under(&self, node: u32) -> Option<u32> {
+        Some(self.nodes[node as usize].prims_under())
     }
 }

@@ -109,8 +109,9 @@ fn relocate(mut node: WideNode, nodes: u32, items: u32) -> WideNode {
 /// The conversion's view of a binary tree: its primitive counts and leaf limits.
 struct Walker<'a, T> {
     tree: &'a T,
-    /// Primitives under each binary node.
-    count: Vec<u32>,
+    /// Primitives under each binary node, counted first if the tree does not record them (empty
+    /// if it does).
+    counted: Vec<u32>,
     /// Most primitives per leaf.
     max_prims: usize,
     /// Subtrees over at most this many primitives become one leaf.
@@ -120,8 +121,13 @@ struct Walker<'a, T> {
 impl<'a, T: BinaryTree> Walker<'a, T> {
     fn new(tree: &'a T, options: ConvertOptions, max_prims: usize) -> Self {
         let max_prims = max_prims.clamp(1, MAX_LEAF_ITEMS);
+        let limit = options.collapse.min(max_prims);
+        if tree.root().is_some_and(|root| tree.prims_under(root).is_some()) {
+            return Walker { tree, counted: Vec::new(), max_prims, limit };
+        }
         // Primitives under each node: the nodes in depth-first order, then counted from the last
-        // (every node's children come after it in that order).
+        // (every node's children come after it in that order). A walk of the whole tree that
+        // misses the caches at nearly every node, which is why trees record their counts.
         let mut order = Vec::with_capacity(tree.slots());
         let mut stack: Vec<u32> = tree.root().into_iter().collect();
         while let Some(i) = stack.pop() {
@@ -131,14 +137,22 @@ impl<'a, T: BinaryTree> Walker<'a, T> {
                 stack.push(first);
             }
         }
-        let mut count = vec![0u32; tree.slots()];
+        let mut counted = vec![0u32; tree.slots()];
         for &i in order.iter().rev() {
-            count[i as usize] = match tree.children(i) {
-                Some([first, second]) => count[first as usize] + count[second as usize],
+            counted[i as usize] = match tree.children(i) {
+                Some([first, second]) => counted[first as usize] + counted[second as usize],
                 None => tree.leaf_range(i).len() as u32,
             };
         }
-        Walker { tree, count, max_prims, limit: options.collapse.min(max_prims) }
+        Walker { tree, counted, max_prims, limit }
+    }
+
+    /// Primitives under binary node `i`.
+    fn count(&self, i: u32) -> u32 {
+        match self.tree.prims_under(i) {
+            Some(n) => n,
+            None => self.counted[i as usize],
+        }
     }
 
     fn bounds_of(&self, p: &Part) -> Aabb {
@@ -150,7 +164,7 @@ impl<'a, T: BinaryTree> Walker<'a, T> {
 
     fn prims_in(&self, p: &Part) -> u32 {
         match *p {
-            Part::Node(i) => self.count[i as usize],
+            Part::Node(i) => self.count(i),
             Part::Range { len, .. } => len,
         }
     }
@@ -159,7 +173,7 @@ impl<'a, T: BinaryTree> Walker<'a, T> {
     fn terminal(&self, p: &Part) -> bool {
         match *p {
             Part::Node(i) => {
-                let n = self.count[i as usize] as usize;
+                let n = self.count(i) as usize;
                 (self.tree.children(i).is_none() && n <= self.max_prims) || n <= self.limit
             }
             Part::Range { len, .. } => len as usize <= self.max_prims,
@@ -170,7 +184,10 @@ impl<'a, T: BinaryTree> Walker<'a, T> {
     fn open(&self, p: &Part) -> [Part; 2] {
         match *p {
             Part::Node(i) => match self.tree.children(i) {
-                Some([first, second]) => [Part::Node(first), Part::Node(second)],
+                Some([first, second]) => {
+                    debug_assert_eq!(self.count(i), self.count(first) + self.count(second), "node {i}'s count");
+                    [Part::Node(first), Part::Node(second)]
+                }
                 None => {
                     let r = self.tree.leaf_range(i);
                     let half = (r.len() / 2) as u32;
@@ -449,7 +466,7 @@ mod tests {
         let all = Aabb::new(Vec3::ZERO, Vec3::splat(n as f32));
         for i in 0..n - 1 {
             let next = if i + 1 == n - 1 { n - 1 } else { n + i + 1 };
-            nodes.push(BuildNode { bounds: all, kind: BuildKind::Interior { children: [i, next] } });
+            nodes.push(BuildNode { bounds: all, kind: BuildKind::Interior { children: [i, next], count: n - i } });
         }
         let boxes: Vec<Aabb> = nodes[..n as usize].iter().map(|b| b.bounds).collect();
         let tree = BuildTree { nodes, prims: (0..n).collect(), root: n };

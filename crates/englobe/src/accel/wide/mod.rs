@@ -307,7 +307,7 @@ mod tests {
         for i in 0..n - 1 {
             let bounds = Aabb::new(Vec3::new(i as f32, 0.0, 0.0), Vec3::new(n as f32, 1.0, 1.0));
             let next = if i + 1 == n - 1 { n - 1 } else { n + i + 1 };
-            nodes.push(BuildNode { bounds, kind: BuildKind::Interior { children: [i, next] } });
+            nodes.push(BuildNode { bounds, kind: BuildKind::Interior { children: [i, next], count: n - i } });
         }
         let bvh = BuildTree { nodes, prims: (0..n).collect(), root: n }.into_bvh();
         (boxes, bvh)

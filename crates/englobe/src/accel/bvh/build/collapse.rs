@@ -26,7 +26,7 @@ pub fn collapse_leaves(tree: &BuildTree, max_leaf: usize) -> BuildTree {
     let mut stack = vec![tree.root];
     while let Some(id) = stack.pop() {
         order.push(id);
-        if let BuildKind::Interior { children } = nodes[id as usize].kind {
+        if let BuildKind::Interior { children, .. } = nodes[id as usize].kind {
             stack.extend(children);
         }
     }
@@ -48,7 +48,7 @@ pub fn collapse_leaves(tree: &BuildTree, max_leaf: usize) -> BuildTree {
                 cost[id] = SAH_INTERSECTION_COST as f64 * c as f64 * w;
                 leaf[id] = true;
             }
-            BuildKind::Interior { children: [a, b] } => {
+            BuildKind::Interior { children: [a, b], .. } => {
                 let (a, b) = (a as usize, b as usize);
                 count[id] = count[a] + count[b];
                 let split = SAH_TRAVERSAL_COST as f64 * w + cost[a] + cost[b];
@@ -67,7 +67,7 @@ pub fn collapse_leaves(tree: &BuildTree, max_leaf: usize) -> BuildTree {
     while let Some((id, parent)) = stack.pop() {
         let here = out.nodes.len() as u32;
         if let Some((p, which)) = parent
-            && let BuildKind::Interior { children } = &mut out.nodes[p].kind
+            && let BuildKind::Interior { children, .. } = &mut out.nodes[p].kind
         {
             children[which] = here;
         }
@@ -80,13 +80,14 @@ pub fn collapse_leaves(tree: &BuildTree, max_leaf: usize) -> BuildTree {
                     BuildKind::Leaf { first, count } => {
                         out.prims.extend_from_slice(&tree.prims[first as usize..(first + count) as usize]);
                     }
-                    BuildKind::Interior { children: [a, b] } => gather.extend([b, a]),
+                    BuildKind::Interior { children: [a, b], .. } => gather.extend([b, a]),
                 }
             }
             let count = out.prims.len() as u32 - first;
             out.nodes.push(BuildNode { bounds: node.bounds, kind: BuildKind::Leaf { first, count } });
-        } else if let BuildKind::Interior { children: [a, b] } = node.kind {
-            out.nodes.push(BuildNode { bounds: node.bounds, kind: BuildKind::Interior { children: [0, 0] } });
+        } else if let BuildKind::Interior { children: [a, b], .. } = node.kind {
+            let count = count[id as usize] as u32;
+            out.nodes.push(BuildNode { bounds: node.bounds, kind: BuildKind::Interior { children: [0, 0], count } });
             stack.push((b, Some((here as usize, 1))));
             stack.push((a, Some((here as usize, 0))));
         }
@@ -122,7 +123,8 @@ mod tests {
                 .map(|c| match *c {
                     [a, b] => {
                         let bounds = nodes[a as usize].bounds.union(&nodes[b as usize].bounds);
-                        nodes.push(BuildNode { bounds, kind: BuildKind::Interior { children: [a, b] } });
+                        let count = nodes[a as usize].prims_under() + nodes[b as usize].prims_under();
+                        nodes.push(BuildNode { bounds, kind: BuildKind::Interior { children: [a, b], count } });
                         nodes.len() as u32 - 1
                     }
                     [a] => a,
@@ -175,7 +177,8 @@ mod tests {
         let mut top = 0u32;
         for i in 1..n {
             let bounds = nodes[top as usize].bounds.union(&nodes[i as usize].bounds);
-            nodes.push(BuildNode { bounds, kind: BuildKind::Interior { children: [top, i] } });
+            let count = nodes[top as usize].prims_under() + 1;
+            nodes.push(BuildNode { bounds, kind: BuildKind::Interior { children: [top, i], count } });
             top = nodes.len() as u32 - 1;
         }
         let boxes: Vec<Aabb> = (0..n).map(|i| unit_at(i as f32)).collect();

@@ -163,8 +163,9 @@ impl Ploc {
                 } else if (i as u32) < j {
                     let j = j as usize;
                     let bounds = cluster_boxes[i].union(&cluster_boxes[j]);
-                    nodes
-                        .push(BuildNode { bounds, kind: BuildKind::Interior { children: [clusters[i], clusters[j]] } });
+                    let children = [clusters[i], clusters[j]];
+                    let count = children.iter().map(|&c| nodes[c as usize].prims_under()).sum();
+                    nodes.push(BuildNode { bounds, kind: BuildKind::Interior { children, count } });
                     clusters[kept] = nodes.len() as u32 - 1;
                     cluster_boxes[kept] = bounds;
                     kept += 1;

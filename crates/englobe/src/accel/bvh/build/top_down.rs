@@ -221,7 +221,8 @@ fn build_parallel<S: Splitter>(
     };
     drop(scratch);
     let right = node_base + 2 * mid as u32;
-    nodes[0] = BuildNode { bounds, kind: BuildKind::Interior { children: [node_base + 1, right] } };
+    nodes[0] =
+        BuildNode { bounds, kind: BuildKind::Interior { children: [node_base + 1, right], count: refs.len() as u32 } };
     let (left_nodes, right_nodes) = nodes[1..].split_at_mut(2 * mid - 1);
     let (left_refs, right_refs) = refs.split_at_mut(mid);
     parallel::join(
@@ -256,7 +257,10 @@ fn build_sequential<S: Splitter>(
                 stack.push((left, start, start + mid));
                 BuildNode {
                     bounds,
-                    kind: BuildKind::Interior { children: [node_base + left as u32, node_base + right as u32] },
+                    kind: BuildKind::Interior {
+                        children: [node_base + left as u32, node_base + right as u32],
+                        count: (end - start) as u32,
+                    },
                 }
             }
         };

@@ -46,7 +46,7 @@ pub fn restructure(tree: &mut BuildTree, max_leaf: usize, passes: u32) {
         stack.push(tree.root);
         while let Some(id) = stack.pop() {
             order.push(id);
-            if let BuildKind::Interior { children } = tree.nodes[id as usize].kind {
+            if let BuildKind::Interior { children, .. } = tree.nodes[id as usize].kind {
                 stack.extend(children);
             }
         }
@@ -107,7 +107,7 @@ impl<W: Fn(&Aabb) -> f64> State<W> {
                 self.cost[id as usize] = SAH_INTERSECTION_COST as f64 * w * count as f64;
                 return;
             }
-            BuildKind::Interior { children } => children,
+            BuildKind::Interior { children, .. } => children,
         };
         let count = self.count[a as usize] + self.count[b as usize];
         self.count[id as usize] = count;
@@ -128,7 +128,7 @@ impl<W: Fn(&Aabb) -> f64> State<W> {
                     x.surface_area().total_cmp(&y.surface_area()).then(j.cmp(&i))
                 });
             let Some(i) = open else { break };
-            let BuildKind::Interior { children: [c, d] } = tree.nodes[leaves[i] as usize].kind else { break };
+            let BuildKind::Interior { children: [c, d], .. } = tree.nodes[leaves[i] as usize].kind else { break };
             interior[m] = leaves[i];
             m += 1;
             (leaves[i], leaves[n]) = (c, d);
@@ -211,7 +211,7 @@ impl<W: Fn(&Aabb) -> f64> State<W> {
             let part = tables.part[s] as usize;
             let children = [child(part), child(s ^ part)];
             let n = &mut tree.nodes[node as usize];
-            (n.bounds, n.kind) = (tables.boxes[s], BuildKind::Interior { children });
+            (n.bounds, n.kind) = (tables.boxes[s], BuildKind::Interior { children, count: tables.counts[s] });
             self.cost[node as usize] = tables.best[s];
             self.count[node as usize] = tables.counts[s];
         }
@@ -273,7 +273,7 @@ mod tests {
         let leaf = |i: u32| BuildNode { bounds: boxes[i as usize], kind: BuildKind::Leaf { first: i, count: 1 } };
         let join = |a: &BuildNode, b: &BuildNode, ca: u32, cb: u32| BuildNode {
             bounds: a.bounds.union(&b.bounds),
-            kind: BuildKind::Interior { children: [ca, cb] },
+            kind: BuildKind::Interior { children: [ca, cb], count: a.prims_under() + b.prims_under() },
         };
         let (l0, l1, l2, l3) = (leaf(0), leaf(1), leaf(2), leaf(3));
         let n4 = join(&l0, &l2, 0, 2);
@@ -298,7 +298,8 @@ mod tests {
         let mut top = 0u32;
         for i in 1..n {
             let bounds = nodes[top as usize].bounds.union(&nodes[i as usize].bounds);
-            nodes.push(BuildNode { bounds, kind: BuildKind::Interior { children: [top, i] } });
+            let count = nodes[top as usize].prims_under() + 1;
+            nodes.push(BuildNode { bounds, kind: BuildKind::Interior { children: [top, i], count } });
             top = nodes.len() as u32 - 1;
         }
         let mut tree = BuildTree { nodes, prims: (0..n).collect(), root: top };
