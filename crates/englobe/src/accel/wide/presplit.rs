@@ -58,28 +58,43 @@ pub struct Fragments {
     pub owner: Vec<u32>,
 }
 
-/// The surface area a triangle's box wastes: the box's area less twice the triangle's projected
-/// areas on the three axis planes (what a box could not avoid covering).
-fn wasted_area(v: &[Vec3; 3], b: &Aabb) -> f32 {
-    let n = (v[1] - v[0]).cross(v[2] - v[0]).abs();
-    (b.surface_area() - (n.x + n.y + n.z)).max(0.0)
+/// A triangle as the presplit sees it: its box, and the surface area the box wastes (the box's
+/// area less twice the triangle's projected areas on the three axis planes: what a box could not
+/// avoid covering). Made where the caller fetches the triangles for their boxes anyway, so that
+/// the presplit does not fetch every one a second time.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TriangleBox {
+    /// The triangle's box.
+    pub bounds: Aabb,
+    /// The area the box wastes.
+    pub waste: f32,
 }
 
-/// Cuts triangles `triangle(i)` for `i` in `0..count` (each of box `boxes[i]`, finite and not
-/// empty) into fragments, with at most `budget * count` fragments more than triangles; only the
-/// triangles whose boxes waste at least [`MIN_WASTE_SHARE`] of the scene's area are cut. The
-/// triangles are cut in parallel; the fragments come in triangle order, whatever the threads.
-pub fn presplit(boxes: &[Aabb], triangle: impl Fn(u32) -> [Vec3; 3] + Sync, budget: f32) -> Fragments {
-    let count = boxes.len();
+impl TriangleBox {
+    /// The box of triangle `v` and its waste.
+    pub fn of(v: &[Vec3; 3]) -> Self {
+        let bounds = Aabb::from_points(*v);
+        let n = (v[1] - v[0]).cross(v[2] - v[0]).abs();
+        TriangleBox { bounds, waste: (bounds.surface_area() - (n.x + n.y + n.z)).max(0.0) }
+    }
+}
+
+/// Cuts triangles `triangle(i)` for `i` in `0..triangles.len()` (each described by
+/// `triangles[i]`, its box finite and not empty) into fragments, with at most `budget *
+/// triangles.len()` fragments more than triangles; only the triangles whose boxes waste at least
+/// [`MIN_WASTE_SHARE`] of the scene's area are cut. The triangles are cut in parallel; the
+/// fragments come in triangle order, whatever the threads.
+pub fn presplit(triangles: &[TriangleBox], triangle: impl Fn(u32) -> [Vec3; 3] + Sync, budget: f32) -> Fragments {
+    let count = triangles.len();
     // References stay within what a build may hold (its bins count them in `i32` lanes).
     let extra = ((budget.max(0.0) * count as f32) as usize).min(MAX_PRIMITIVES.saturating_sub(count));
-    let whole = || Fragments { boxes: boxes.to_vec(), owner: (0..count as u32).collect() };
+    let whole =
+        || Fragments { boxes: triangles.iter().map(|t| t.bounds).collect(), owner: (0..count as u32).collect() };
     if extra == 0 {
         return whole();
     }
-    let scene = boxes.iter().fold(Aabb::EMPTY, |s, b| s.union(b));
-    let waste: Vec<f32> = collect_indexed(count, 1 << 12, |i| wasted_area(&triangle(i as u32), &boxes[i]));
-    let total: f64 = waste.iter().map(|&w| w as f64).sum();
+    let (scene, total) =
+        triangles.iter().fold((Aabb::EMPTY, 0f64), |(s, w), t| (s.union(&t.bounds), w + t.waste as f64));
     if !(total > 0.0) || !scene.is_finite() {
         return whole();
     }
@@ -88,25 +103,26 @@ pub fn presplit(boxes: &[Aabb], triangle: impl Fn(u32) -> [Vec3; 3] + Sync, budg
     let share = extra as f64 / total;
     let floor = scene.surface_area() * MIN_WASTE_SHARE;
     let pieces = |i: usize| {
-        if waste[i] < floor { 1 } else { (1 + (waste[i] as f64 * share) as usize).min(MAX_PIECES) }
+        let waste = triangles[i].waste;
+        if waste < floor { 1 } else { (1 + (waste as f64 * share) as usize).min(MAX_PIECES) }
     };
     let cut_ones: Vec<u32> = (0..count as u32).filter(|&i| pieces(i as usize) > 1).collect();
     let cut_boxes: Vec<Vec<Aabb>> = collect_indexed(cut_ones.len(), 64, |k| {
         let i = cut_ones[k];
         let mut out = Vec::with_capacity(pieces(i as usize));
-        cut(&Polygon::triangle(triangle(i)), boxes[i as usize], pieces(i as usize), &scene, &mut out);
+        cut(&Polygon::triangle(triangle(i)), triangles[i as usize].bounds, pieces(i as usize), &scene, &mut out);
         out
     });
     let mut out = Fragments { boxes: Vec::with_capacity(count + extra), owner: Vec::with_capacity(count + extra) };
     let mut next_cut = cut_ones.iter().zip(&cut_boxes).peekable();
-    for (i, b) in boxes.iter().enumerate() {
+    for (i, t) in triangles.iter().enumerate() {
         match next_cut.next_if(|(c, _)| **c == i as u32) {
             Some((_, parts)) => {
                 out.boxes.extend_from_slice(parts);
                 out.owner.extend(std::iter::repeat_n(i as u32, parts.len()));
             }
             None => {
-                out.boxes.push(*b);
+                out.boxes.push(t.bounds);
                 out.owner.push(i as u32);
             }
         }
@@ -168,6 +184,13 @@ fn cut(part: &Polygon, b: Aabb, pieces: usize, scene: &Aabb, out: &mut Vec<Aabb>
 mod tests {
     use super::*;
 
+    /// The presplit's view of `tris`, and their boxes.
+    fn described(tris: &[[Vec3; 3]]) -> (Vec<TriangleBox>, Vec<Aabb>) {
+        let input: Vec<TriangleBox> = tris.iter().map(TriangleBox::of).collect();
+        let boxes = input.iter().map(|t| t.bounds).collect();
+        (input, boxes)
+    }
+
     fn diagonal(n: usize) -> Vec<[Vec3; 3]> {
         // Long thin triangles along the diagonal of a unit cube, and small ones for a budget.
         let mut t: Vec<[Vec3; 3]> = (0..n)
@@ -183,8 +206,8 @@ mod tests {
     #[test]
     fn the_wasteful_triangle_is_cut_and_its_pieces_cover_it() {
         let tris = diagonal(50);
-        let boxes: Vec<Aabb> = tris.iter().map(|t| Aabb::from_points(*t)).collect();
-        let f = presplit(&boxes, |i| tris[i as usize], 0.2);
+        let (input, boxes) = described(&tris);
+        let f = presplit(&input, |i| tris[i as usize], 0.2);
         let long = (tris.len() - 1) as u32;
         let pieces: Vec<Aabb> = f.owner.iter().zip(&f.boxes).filter(|(o, _)| **o == long).map(|(_, b)| *b).collect();
         assert!(pieces.len() >= 4, "{} pieces", pieces.len());
@@ -223,28 +246,38 @@ mod tests {
                 }
             })
             .collect();
-        let boxes: Vec<Aabb> = tris.iter().map(|t| Aabb::from_points(*t)).collect();
-        let total: f32 = tris.iter().zip(&boxes).map(|(t, b)| wasted_area(t, b)).sum();
-        let waste = wasted_area(&tris[0], &boxes[0]);
+        let (input, boxes) = described(&tris);
+        let total: f32 = input.iter().map(|t| t.waste).sum();
+        let waste = input[0].waste;
         let scene = boxes.iter().fold(Aabb::EMPTY, |s, b| s.union(b));
         assert!(waste * 4_000.0 / total >= 1.0, "{waste} of {total}");
         assert!(waste < scene.surface_area() * MIN_WASTE_SHARE);
-        let f = presplit(&boxes, |i| tris[i as usize], 0.4);
+        let f = presplit(&input, |i| tris[i as usize], 0.4);
         assert_eq!(f.boxes, boxes);
         // The same triangle grown to a fifth of the scene is cut.
         tris[0] = [Vec3::ZERO, Vec3::splat(20.0), Vec3::new(20.0, 18.0, 20.0)];
-        let boxes: Vec<Aabb> = tris.iter().map(|t| Aabb::from_points(*t)).collect();
-        let f = presplit(&boxes, |i| tris[i as usize], 0.4);
+        let (input, boxes) = described(&tris);
+        let f = presplit(&input, |i| tris[i as usize], 0.4);
         let pieces = f.owner.iter().filter(|&&o| o == 0).count();
         assert!(pieces > 1, "{pieces} pieces");
         assert!(f.owner[pieces..].iter().copied().eq(1..10_000));
     }
 
     #[test]
+    fn a_box_wastes_what_the_triangle_does_not_cover() {
+        // Half the unit square: the box's two faces have area 2, the triangle covers half.
+        let t = TriangleBox::of(&[Vec3::ZERO, Vec3::X, Vec3::Y]);
+        assert_eq!((t.bounds, t.waste), (Aabb::new(Vec3::ZERO, Vec3::new(1.0, 1.0, 0.0)), 1.0));
+        // Tilted out of every axis plane: its projections cover half of each face pair.
+        let t = TriangleBox::of(&[Vec3::ZERO, Vec3::new(1.0, 1.0, 0.0), Vec3::new(0.0, 1.0, 1.0)]);
+        assert_eq!(t.waste, 6.0 - 3.0);
+    }
+
+    #[test]
     fn no_budget_no_split() {
         let tris = diagonal(3);
-        let boxes: Vec<Aabb> = tris.iter().map(|t| Aabb::from_points(*t)).collect();
-        let f = presplit(&boxes, |i| tris[i as usize], 0.0);
+        let (input, boxes) = described(&tris);
+        let f = presplit(&input, |i| tris[i as usize], 0.0);
         assert_eq!(f.boxes, boxes);
         assert_eq!(f.owner, vec![0, 1, 2, 3]);
     }

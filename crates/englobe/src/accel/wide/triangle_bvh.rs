@@ -12,7 +12,7 @@ use super::convert::{BinaryTree, ConvertOptions, LeafSink, convert};
 use super::dispatch;
 use super::isa::{Isa, IsaUnavailable};
 use super::node::{NodeRay, WideNode, may_enter, reach};
-use super::presplit::presplit;
+use super::presplit::{TriangleBox, presplit};
 use super::traverse::Leaves;
 use super::triangles::{LANES, TriBlock, TriRay, UNUSED, intersect_block, is_storable};
 use crate::accel::bvh::BinnedSah;
@@ -189,17 +189,34 @@ impl TriangleBvh {
     /// are triangles with non-finite coordinates.
     pub fn build_with(count: usize, triangle: impl Fn(u32) -> [Vec3; 3] + Sync, options: TriangleBvhOptions) -> Self {
         let count = count.min(MAX_PRIMITIVES);
-        let boxes = collect_indexed(count, 1 << 14, |i| {
+        // Each triangle's box and the area it wastes, in the one pass that fetches the triangles;
+        // an empty box marks one left out.
+        let described = collect_indexed(count, 1 << 14, |i| {
             let v = triangle(i as u32);
-            if v.iter().all(|p| p.is_finite()) && is_storable(&v) { Aabb::from_points(v) } else { Aabb::EMPTY }
+            if v.iter().all(|p| p.is_finite()) && is_storable(&v) {
+                TriangleBox::of(&v)
+            } else {
+                TriangleBox { bounds: Aabb::EMPTY, waste: 0.0 }
+            }
         });
-        let ids: Vec<u32> = (0..count as u32).filter(|&i| boxes[i as usize].is_finite()).collect();
-        let kept: Vec<Aabb> = if ids.len() == count { boxes } else { ids.iter().map(|&i| boxes[i as usize]).collect() };
+        // The triangles kept, by index, unless all are (then index `i` is triangle `i`).
+        let ids: Option<Vec<u32>> = (!described.iter().all(|t| t.bounds.is_finite()))
+            .then(|| (0..count as u32).filter(|&i| described[i as usize].bounds.is_finite()).collect());
+        let kept: Vec<TriangleBox> = match &ids {
+            Some(ids) => ids.iter().map(|&i| described[i as usize]).collect(),
+            None => described,
+        };
+        let id = |k: u32| ids.as_ref().map_or(k, |ids| ids[k as usize]);
         let budget = options.presplit_percent as f32 / 100.0;
-        let fragments = presplit(&kept, |i| triangle(ids[i as usize]), budget);
+        let fragments = presplit(&kept, |k| triangle(id(k)), budget);
+        let (stored, cut) = (kept.len(), fragments.boxes.len() > kept.len());
+        drop(kept);
         // The builder's tree as it comes, without the binary layout: only its wide form is kept.
         let tree = options.builder.build_tree(&fragments.boxes);
-        let owners: Vec<u32> = fragments.owner.iter().map(|&k| ids[k as usize]).collect();
+        let owners: Vec<u32> = match &ids {
+            Some(_) => fragments.owner.iter().map(|&k| id(k)).collect(),
+            None => fragments.owner,
+        };
         let mut sink = Blocks { ids: &owners, blocks: Vec::new(), leaf_ids: Vec::new() };
         let layout = convert(&tree, ConvertOptions { collapse: options.collapse }, &mut sink);
         let mut built = TriangleBvh {
@@ -207,9 +224,9 @@ impl TriangleBvh {
             blocks: sink.fill(&triangle),
             depth: layout.depth,
             bounds: tree.root().map_or(Aabb::EMPTY, |root| tree.bounds(root)),
-            stored: ids.len(),
+            stored,
             count,
-            cut: fragments.boxes.len() > kept.len(),
+            cut,
             options,
             built_sah_cost: 0.0,
             isa: Isa::best(),
