@@ -256,7 +256,7 @@ mod tests {
         assert_eq!(f.boxes, boxes);
         // The same triangle grown to a fifth of the scene is cut.
         tris[0] = [Vec3::ZERO, Vec3::splat(20.0), Vec3::new(20.0, 18.0, 20.0)];
-        let (input, boxes) = described(&tris);
+        let (input, _) = described(&tris);
         let f = presplit(&input, |i| tris[i as usize], 0.4);
         let pieces = f.owner.iter().filter(|&&o| o == 0).count();
         assert!(pieces > 1, "{pieces} pieces");
