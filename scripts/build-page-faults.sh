@@ -9,8 +9,7 @@
 #
 # MESH is a harness scene (`name=path`); LIBRARY defaults to englobe,embree (`embree` needs the
 # harness built with the `embree` feature). Two threads. The binary is ENGLOBE_BENCH (default
-# target/release/englobe-bench), used as it is: build it with and without its default
-# `mimalloc` feature (`--no-default-features`) to compare the allocators.
+# target/release/englobe-bench), used as it is.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 [[ $# -ge 1 ]] || { sed -n '8,13s/^# \{0,1\}//p' "$0" >&2; exit 2; }
