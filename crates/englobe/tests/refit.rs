@@ -176,3 +176,28 @@ fn the_moved_bunny_agrees_with_brute_force_and_a_fresh_build() {
     assert!(!report.rebuilt && (0.9..1.5).contains(&ratio), "{report:?}, fresh {}", fresh.sah_cost());
     assert!(report.cost_ratio() > 0.9, "{report:?}");
 }
+
+#[test]
+fn the_built_cost_is_the_tree_as_built_across_refits() {
+    // A 10 x 10 grid of small triangles, then the same triangles lifted by uneven heights twice:
+    // each refit loosens the boxes, and the cost as built must stay the first tree's.
+    let grid = |lift: u32| -> Vec<[f32; 3]> {
+        (0..100u32)
+            .flat_map(|k| {
+                let (x, y, z) = ((k % 10) as f32, (k / 10) as f32, ((k * lift) % 13) as f32);
+                [[x, y, z], [x + 0.5, y, z], [x, y + 0.5, z + 0.25]]
+            })
+            .collect()
+    };
+    let triangles: Vec<[u32; 3]> = (0..100u32).map(|k| [3 * k, 3 * k + 1, 3 * k + 2]).collect();
+    let mut bvh = TriangleBvh::from_arrays(&grid(0), &triangles).unwrap();
+    let as_built = bvh.sah_cost();
+    assert_eq!(bvh.built_sah_cost(), as_built);
+    for lift in [7, 11] {
+        let report = bvh.refit_arrays(&grid(lift), &triangles).unwrap();
+        assert!(!report.rebuilt);
+        assert_eq!((report.built_sah_cost, bvh.built_sah_cost()), (as_built, as_built));
+        assert_eq!(report.sah_cost, bvh.sah_cost());
+        assert!(report.cost_ratio() > 1.5, "{report:?}");
+    }
+}

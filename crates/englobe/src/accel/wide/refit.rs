@@ -101,7 +101,7 @@ impl TriangleBvh {
 
     /// The SAH cost the tree had when it was built.
     pub fn built_sah_cost(&self) -> f32 {
-        self.built_sah_cost
+        self.built_sah_cost.unwrap_or_else(|| self.sah_cost())
     }
 
     /// Refits the structure to the moved vertices of `mesh`, built from the same mesh (the same
@@ -142,6 +142,9 @@ impl TriangleBvh {
         if given != self.count {
             return Err(RefitError::TriangleCount { built: self.count, given: count });
         }
+        // The cost as built: made now if this is the tree's first refit (its boxes are about to
+        // move).
+        let built_sah_cost = self.built_sah_cost();
         let hittable = |v: &[Vec3; 3]| v.iter().all(|p| p.is_finite()) && is_storable(v);
         // The blocks, their lanes kept; unused lanes repeat the first, as built.
         let mut scratch_ok = all_mut(&mut self.blocks, 1 << 10, |block| {
@@ -165,11 +168,8 @@ impl TriangleBvh {
             let isa = self.isa;
             *self = TriangleBvh::build_with(count, triangle, self.options);
             self.isa = isa;
-            return Ok(RefitReport {
-                rebuilt: true,
-                sah_cost: self.built_sah_cost,
-                built_sah_cost: self.built_sah_cost,
-            });
+            let cost = self.built_sah_cost();
+            return Ok(RefitReport { rebuilt: true, sah_cost: cost, built_sah_cost: cost });
         }
         // The boxes, children before parents.
         let mut node_box = vec![Aabb::EMPTY; self.nodes.len()];
@@ -199,6 +199,7 @@ impl TriangleBvh {
             node_box[i] = all;
         }
         self.bounds = node_box.first().copied().unwrap_or(Aabb::EMPTY);
-        Ok(RefitReport { rebuilt: false, sah_cost: self.sah_cost(), built_sah_cost: self.built_sah_cost })
+        self.built_sah_cost = Some(built_sah_cost);
+        Ok(RefitReport { rebuilt: false, sah_cost: self.sah_cost(), built_sah_cost })
     }
 }

@@ -77,8 +77,10 @@ pub struct TriangleBvh {
     /// Whether some triangle lies in several leaves (it was cut before the build).
     pub(super) cut: bool,
     pub(super) options: TriangleBvhOptions,
-    /// The SAH cost when built (see [`TriangleBvh::sah_cost`]).
-    pub(super) built_sah_cost: f32,
+    /// The SAH cost when built (see [`TriangleBvh::sah_cost`]), once the tree has been refitted;
+    /// `None` before: the tree is then as built, and the cost is computed when asked for (it
+    /// walks every node, a few percent of a build that most programs never ask for).
+    pub(super) built_sah_cost: Option<f32>,
     pub(super) isa: Isa,
 }
 
@@ -219,7 +221,7 @@ impl TriangleBvh {
         };
         let mut sink = Blocks { ids: &owners, blocks: Vec::new(), leaf_ids: Vec::new() };
         let layout = convert(&tree, ConvertOptions { collapse: options.collapse }, &mut sink);
-        let mut built = TriangleBvh {
+        TriangleBvh {
             nodes: layout.nodes,
             blocks: sink.fill(&triangle),
             depth: layout.depth,
@@ -228,11 +230,9 @@ impl TriangleBvh {
             count,
             cut,
             options,
-            built_sah_cost: 0.0,
+            built_sah_cost: None,
             isa: Isa::best(),
-        };
-        built.built_sah_cost = built.sah_cost();
-        built
+        }
     }
 
     /// The instruction set queries run with.
