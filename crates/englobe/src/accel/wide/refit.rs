@@ -142,9 +142,6 @@ impl TriangleBvh {
         if given != self.count {
             return Err(RefitError::TriangleCount { built: self.count, given: count });
         }
-        // The cost as built: made now if this is the tree's first refit (its boxes are about to
-        // move).
-        let built_sah_cost = self.built_sah_cost();
         let hittable = |v: &[Vec3; 3]| v.iter().all(|p| p.is_finite()) && is_storable(v);
         // The blocks, their lanes kept; unused lanes repeat the first, as built.
         let mut scratch_ok = all_mut(&mut self.blocks, 1 << 10, |block| {
@@ -171,6 +168,9 @@ impl TriangleBvh {
             let cost = self.built_sah_cost();
             return Ok(RefitReport { rebuilt: true, sah_cost: cost, built_sah_cost: cost });
         }
+        // The cost as built: made now if this is the tree's first refit (its boxes are about to
+        // move; the blocks' triangles, moved above, do not enter it).
+        let built_sah_cost = self.built_sah_cost();
         // The boxes, children before parents.
         let mut node_box = vec![Aabb::EMPTY; self.nodes.len()];
         for i in (0..self.nodes.len()).rev() {

@@ -34,9 +34,7 @@ pub fn collapse_leaves(tree: &BuildTree, max_leaf: usize) -> BuildTree {
     // segment), every node counts as reached, as in `Bvh::sah_cost`.
     let root_area = nodes[tree.root as usize].bounds.surface_area() as f64;
     let weight = |n: &BuildNode| if root_area > 0.0 { n.bounds.surface_area() as f64 } else { 1.0 };
-    // Children before parents: each node's primitive count, best cost, and whether it becomes a
-    // leaf.
-    let mut count = vec![0usize; nodes.len()];
+    // Children before parents: each node's best cost, and whether it becomes a leaf.
     let mut cost = vec![0f64; nodes.len()];
     let mut leaf = vec![false; nodes.len()];
     for &id in order.iter().rev() {
@@ -44,16 +42,14 @@ pub fn collapse_leaves(tree: &BuildTree, max_leaf: usize) -> BuildTree {
         let w = weight(&nodes[id]);
         match nodes[id].kind {
             BuildKind::Leaf { count: c, .. } => {
-                count[id] = c as usize;
                 cost[id] = SAH_INTERSECTION_COST as f64 * c as f64 * w;
                 leaf[id] = true;
             }
-            BuildKind::Interior { children: [a, b], .. } => {
+            BuildKind::Interior { children: [a, b], count } => {
                 let (a, b) = (a as usize, b as usize);
-                count[id] = count[a] + count[b];
                 let split = SAH_TRAVERSAL_COST as f64 * w + cost[a] + cost[b];
-                let as_leaf = SAH_INTERSECTION_COST as f64 * count[id] as f64 * w;
-                leaf[id] = count[id] <= max_leaf && as_leaf <= split;
+                let as_leaf = SAH_INTERSECTION_COST as f64 * count as f64 * w;
+                leaf[id] = count as usize <= max_leaf && as_leaf <= split;
                 cost[id] = if leaf[id] { as_leaf } else { split };
             }
         }
@@ -85,8 +81,7 @@ pub fn collapse_leaves(tree: &BuildTree, max_leaf: usize) -> BuildTree {
             }
             let count = out.prims.len() as u32 - first;
             out.nodes.push(BuildNode { bounds: node.bounds, kind: BuildKind::Leaf { first, count } });
-        } else if let BuildKind::Interior { children: [a, b], .. } = node.kind {
-            let count = count[id as usize] as u32;
+        } else if let BuildKind::Interior { children: [a, b], count } = node.kind {
             out.nodes.push(BuildNode { bounds: node.bounds, kind: BuildKind::Interior { children: [0, 0], count } });
             stack.push((b, Some((here as usize, 1))));
             stack.push((a, Some((here as usize, 0))));

@@ -31,13 +31,7 @@ pub fn restructure(tree: &mut BuildTree, max_leaf: usize, passes: u32) {
     }
     let root_area = tree.nodes[tree.root as usize].bounds.surface_area() as f64;
     let weight = move |b: &Aabb| if root_area > 0.0 { b.surface_area() as f64 } else { 1.0 };
-    let mut state = State {
-        cost: vec![0.0; tree.nodes.len()],
-        count: vec![0; tree.nodes.len()],
-        max_leaf: max_leaf.max(1),
-        weight,
-        subsets: None,
-    };
+    let mut state = State { cost: vec![0.0; tree.nodes.len()], max_leaf: max_leaf.max(1), weight, subsets: None };
     let mut order = Vec::with_capacity(tree.nodes.len());
     let mut stack = Vec::new();
     for _ in 0..passes {
@@ -60,8 +54,6 @@ pub fn restructure(tree: &mut BuildTree, max_leaf: usize, passes: u32) {
 struct State<W> {
     /// SAH cost of each node's subtree, unnormalised (areas, not probabilities).
     cost: Vec<f64>,
-    /// Primitives under each node.
-    count: Vec<u32>,
     max_leaf: usize,
     weight: W,
     /// The dynamic programme's tables, kept from treelet to treelet (taken while in use).
@@ -103,14 +95,12 @@ impl<W: Fn(&Aabb) -> f64> State<W> {
         let w = (self.weight)(&node.bounds);
         let [a, b] = match node.kind {
             BuildKind::Leaf { count, .. } => {
-                self.count[id as usize] = count;
                 self.cost[id as usize] = SAH_INTERSECTION_COST as f64 * w * count as f64;
                 return;
             }
             BuildKind::Interior { children, .. } => children,
         };
-        let count = self.count[a as usize] + self.count[b as usize];
-        self.count[id as usize] = count;
+        let count = node.prims_under();
         let current = self.node_cost(w, count, self.cost[a as usize] + self.cost[b as usize]);
         self.cost[id as usize] = current;
 
@@ -146,7 +136,8 @@ impl<W: Fn(&Aabb) -> f64> State<W> {
             let low = s & s.wrapping_neg();
             if s == low {
                 let leaf = leaves[low.trailing_zeros() as usize] as usize;
-                (boxes[s], counts[s], best[s]) = (tree.nodes[leaf].bounds, self.count[leaf], self.cost[leaf]);
+                (boxes[s], counts[s], best[s]) =
+                    (tree.nodes[leaf].bounds, tree.nodes[leaf].prims_under(), self.cost[leaf]);
                 continue;
             }
             boxes[s] = boxes[low].union(&boxes[s ^ low]);
@@ -213,7 +204,6 @@ impl<W: Fn(&Aabb) -> f64> State<W> {
             let n = &mut tree.nodes[node as usize];
             (n.bounds, n.kind) = (tables.boxes[s], BuildKind::Interior { children, count: tables.counts[s] });
             self.cost[node as usize] = tables.best[s];
-            self.count[node as usize] = tables.counts[s];
         }
     }
 }
