@@ -76,11 +76,11 @@ enum Part {
 }
 
 /// Subtrees over at least this many primitives convert their children's subtrees in parallel.
-const PARALLEL_MIN: u32 = 1 << 14;
+pub(super) const PARALLEL_MIN: u32 = 1 << 14;
 
 /// Wide levels below which subtrees are converted in parallel (up to 8^4 subtrees: plenty of work
 /// for every core).
-const PARALLEL_LEVELS: u32 = 4;
+pub(super) const PARALLEL_LEVELS: u32 = 4;
 
 /// Converts `tree` into wide nodes, its leaves stored through `sink`.
 ///
@@ -99,7 +99,7 @@ where
 }
 
 /// `node` moved `nodes` nodes and `items` leaf items further: its references follow.
-fn relocate(mut node: WideNode, nodes: u32, items: u32) -> WideNode {
+pub(super) fn relocate(mut node: WideNode, nodes: u32, items: u32) -> WideNode {
     for c in node.children.iter_mut().filter(|c| **c != EMPTY) {
         *c = if is_leaf(*c) { LEAF | (index_of(*c) + items) } else { *c + nodes };
     }

@@ -15,7 +15,8 @@
 //!
 //! * [`node`]: the 256-byte node, child references, the scalar reference slab test.
 //! * [`convert`](mod@convert): binary tree ([`binary`]: either kind the builders give) to wide
-//!   nodes (largest boxes pulled up first, subtrees in parallel).
+//!   nodes (largest boxes pulled up first, subtrees in parallel); [`build`](mod@build): the
+//!   same wide nodes built straight from the primitives' boxes, without the binary tree.
 //! * [`isa`]: the instruction sets, detected at run time; [`kernels`]: the slab test of eight
 //!   children for each; `dispatch` (inside the crate): the per-query choice.
 //! * [`traverse`]: the single-ray traversal, generic over kernels and leaves; [`packet`]: the
@@ -32,6 +33,7 @@
 
 pub mod binary;
 pub mod box_query;
+pub mod build;
 pub mod convert;
 // The per-query choice of compiled kernels: safe to call only with a structure's own nodes and
 // instruction set, so it stays inside the crate.

@@ -3,12 +3,14 @@
 //! no index and calls no closure: closest hit and any hit of a ray, answered as `(t, triangle,
 //! u, v)`, exactly as the scalar watertight test and brute force would answer them.
 //!
-//! Built by the binned SAH builder ([`BinnedSah`], parallel), converted to eight-wide nodes
-//! ([`super::convert`](mod@super::convert)) with subtrees of up to four triangles collapsed into one block.
+//! Built by the binned SAH builder's splits ([`BinnedSah`], parallel) straight into eight-wide
+//! nodes ([`super::build`](mod@super::build)), with subtrees of up to four triangles collapsed
+//! into one block.
 
 use glam::Vec3;
 
-use super::convert::{BinaryTree, ConvertOptions, LeafSink, convert};
+use super::build::build_wide;
+use super::convert::{ConvertOptions, LeafSink};
 use super::dispatch;
 use super::isa::{Isa, IsaUnavailable};
 use super::node::{NodeRay, WideNode, may_enter, reach};
@@ -213,19 +215,19 @@ impl TriangleBvh {
         let fragments = presplit(&kept, |k| triangle(id(k)), budget);
         let (stored, cut) = (kept.len(), fragments.boxes.len() > kept.len());
         drop(kept);
-        // The builder's tree as it comes, without the binary layout: only its wide form is kept.
-        let tree = options.builder.build_tree(&fragments.boxes);
         let owners: Vec<u32> = match &ids {
             Some(_) => fragments.owner.iter().map(|&k| id(k)).collect(),
             None => fragments.owner,
         };
         let mut sink = Blocks { ids: &owners, blocks: Vec::new(), leaf_ids: Vec::new() };
-        let layout = convert(&tree, ConvertOptions { collapse: options.collapse }, &mut sink);
+        // Wide nodes straight from the boxes: no binary tree in between.
+        let (layout, bounds) =
+            build_wide(&options.builder, &fragments.boxes, ConvertOptions { collapse: options.collapse }, &mut sink);
         TriangleBvh {
             nodes: layout.nodes,
             blocks: sink.fill(&triangle),
             depth: layout.depth,
-            bounds: tree.root().map_or(Aabb::EMPTY, |root| tree.bounds(root)),
+            bounds,
             stored,
             count,
             cut,

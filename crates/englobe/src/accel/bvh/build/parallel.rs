@@ -51,6 +51,18 @@ pub fn collect_indexed<T: Send>(n: usize, min_chunk: usize, f: impl Fn(usize) ->
     (0..n).map(f).collect()
 }
 
+/// `f` of each of `items`, in order; in parallel, one task per item, when the `parallel` feature
+/// is on (for a few large pieces of work).
+#[inline]
+pub fn map_each<T: Send, R: Send>(items: Vec<T>, f: impl Fn(T) -> R + Sync) -> Vec<R> {
+    #[cfg(feature = "parallel")]
+    if items.len() > 1 {
+        use rayon::prelude::*;
+        return items.into_par_iter().map(&f).collect();
+    }
+    items.into_iter().map(f).collect()
+}
+
 /// Runs `f` on every element of `v`, in parallel (in chunks of at least `min_chunk`) when the
 /// `parallel` feature is on and `v` is long enough; true if `f` returned true for all of them.
 #[inline]

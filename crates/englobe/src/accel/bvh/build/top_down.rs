@@ -177,7 +177,7 @@ fn piece_bounds(refs: &[PrimRef]) -> (Aabb, Aabb) {
 }
 
 /// Where to split `refs`: `Some(mid)` with `0 < mid < len`, or `None` for a leaf.
-fn decide<S: Splitter>(
+pub fn decide<S: Splitter>(
     splitter: &S,
     refs: &mut [PrimRef],
     bounds: &Aabb,
