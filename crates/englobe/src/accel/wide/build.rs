@@ -15,8 +15,9 @@
 //! node, whenever the splitter leaves ranges of at most [`ConvertOptions::collapse`] references
 //! alone (a leaf's references may otherwise come in another order).
 
-use super::convert::{ConvertOptions, LeafSink, PARALLEL_LEVELS, PARALLEL_MIN, WideLayout, relocate};
+use super::convert::{ConvertOptions, LeafSink, PARALLEL_LEVELS, PARALLEL_MIN, WideLayout};
 use super::node::{LEAF, MAX_LEAF_ITEMS, WIDTH, WideNode};
+use super::pieces::Pieces;
 use crate::Aabb;
 use crate::accel::bvh::build::parallel::{self, collect_indexed};
 use crate::accel::bvh::build::top_down::{PrimRef, Splitter, decide, range_bounds};
@@ -199,9 +200,27 @@ impl<S: Splitter> Builder<'_, S> {
         if levels == 0 || (part.len() as u32) < PARALLEL_MIN {
             return self.walk(refs, base, part, sink);
         }
+        self.pieces(refs, base, part, &*sink, levels).assemble(sink)
+    }
+
+    /// [`Builder::build`]'s subtree as pieces, each with leaf items of its own (made by
+    /// `template`'s [`LeafSink::split`]), stored together at the end.
+    fn pieces<K: LeafSink + Send + Sync>(
+        &self,
+        refs: &mut [PrimRef],
+        base: u32,
+        part: Part,
+        template: &K,
+        levels: u32,
+    ) -> Pieces<K> {
+        let mut items = template.split();
+        if levels == 0 || (part.len() as u32) < PARALLEL_MIN {
+            let layout = self.walk(refs, base, part, &mut items);
+            return Pieces::walked(layout, items);
+        }
         let mut scratch = Scratch::default();
         let mut subtrees = Vec::new();
-        let mut node = self.node(refs, base, part, sink, &mut scratch, |slot, p| {
+        let node = self.node(refs, base, part, &mut items, &mut scratch, |slot, p| {
             subtrees.push((slot, p));
             0
         });
@@ -209,28 +228,15 @@ impl<S: Splitter> Builder<'_, S> {
         // references: each subtree gets its own.
         let mut jobs = Vec::with_capacity(subtrees.len());
         let (mut rest, mut at) = (refs, base);
-        for &(_, p) in &subtrees {
+        for &(slot, p) in &subtrees {
             let (_, tail) = std::mem::take(&mut rest).split_at_mut((p.start - at) as usize);
             let (mine, tail) = tail.split_at_mut(p.len());
-            jobs.push((p, mine));
+            jobs.push((slot, p, mine));
             (rest, at) = (tail, p.end);
         }
-        let template = &*sink;
-        let built = parallel::map_each(jobs, |(p, mine)| {
-            let mut items = template.split();
-            (self.build(mine, p.start, p, &mut items, levels - 1), items)
-        });
-        let mut nodes = vec![WideNode::EMPTY_NODE];
-        let mut depth = 1;
-        for (&(slot, _), (layout, items)) in subtrees.iter().zip(built) {
-            let first_node = nodes.len() as u32;
-            let first_item = sink.join(items);
-            node.children[slot] = first_node;
-            nodes.extend(layout.nodes.into_iter().map(|n| relocate(n, first_node, first_item)));
-            depth = depth.max(1 + layout.depth);
-        }
-        nodes[0] = node;
-        WideLayout { nodes, depth }
+        let built =
+            parallel::map_each(jobs, |(slot, p, mine)| (slot, self.pieces(mine, p.start, p, template, levels - 1)));
+        Pieces::joined(node, items, built)
     }
 
     /// The wide subtree standing for `part` (its root is node 0), from an explicit work stack.

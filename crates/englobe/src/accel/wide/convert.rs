@@ -22,7 +22,8 @@
 //! converted in parallel (see [`convert`]).
 
 pub use super::binary::BinaryTree;
-use super::node::{EMPTY, LEAF, MAX_LEAF_ITEMS, WIDTH, WideNode, index_of, is_leaf};
+use super::node::{LEAF, MAX_LEAF_ITEMS, WIDTH, WideNode};
+use super::pieces::Pieces;
 use crate::Aabb;
 use crate::accel::bvh::build::parallel::collect_indexed;
 
@@ -96,14 +97,6 @@ where
         return WideLayout::default();
     };
     Walker::new(tree, options, sink.max_prims()).convert(Part::Node(root), sink, PARALLEL_LEVELS)
-}
-
-/// `node` moved `nodes` nodes and `items` leaf items further: its references follow.
-pub(super) fn relocate(mut node: WideNode, nodes: u32, items: u32) -> WideNode {
-    for c in node.children.iter_mut().filter(|c| **c != EMPTY) {
-        *c = if is_leaf(*c) { LEAF | (index_of(*c) + items) } else { *c + nodes };
-    }
-    node
 }
 
 /// The conversion's view of a binary tree: its primitive counts and leaf limits.
@@ -272,29 +265,30 @@ impl<'a, T: BinaryTree> Walker<'a, T> {
         if levels == 0 || self.prims_in(&part) < PARALLEL_MIN {
             return self.walk(part, sink);
         }
+        self.pieces(part, &*sink, levels).assemble(sink)
+    }
+
+    /// [`Walker::convert`]'s subtree as pieces, each with leaf items of its own (made by
+    /// `template`'s [`LeafSink::split`]), stored together at the end.
+    fn pieces<S: LeafSink + Send + Sync>(&self, part: Part, template: &S, levels: u32) -> Pieces<S>
+    where
+        T: Sync,
+    {
+        let mut items = template.split();
+        if levels == 0 || self.prims_in(&part) < PARALLEL_MIN {
+            let layout = self.walk(part, &mut items);
+            return Pieces::walked(layout, items);
+        }
         let mut scratch = Scratch::default();
         // The interior children are placed once their subtrees are converted.
         let mut subtrees = Vec::new();
-        let mut node = self.node(part, sink, &mut scratch, |slot, p| {
+        let node = self.node(part, &mut items, &mut scratch, |slot, p| {
             subtrees.push((slot, p));
             0
         });
-        let template = &*sink;
-        let converted = collect_indexed(subtrees.len(), 1, |i| {
-            let mut items = template.split();
-            (self.convert(subtrees[i].1, &mut items, levels - 1), items)
-        });
-        let mut nodes = vec![WideNode::EMPTY_NODE];
-        let mut depth = 1;
-        for (&(slot, _), (layout, items)) in subtrees.iter().zip(converted) {
-            let first_node = nodes.len() as u32;
-            let first_item = sink.join(items);
-            node.children[slot] = first_node;
-            nodes.extend(layout.nodes.into_iter().map(|n| relocate(n, first_node, first_item)));
-            depth = depth.max(1 + layout.depth);
-        }
-        nodes[0] = node;
-        WideLayout { nodes, depth }
+        let converted =
+            collect_indexed(subtrees.len(), 1, |i| (subtrees[i].0, self.pieces(subtrees[i].1, template, levels - 1)));
+        Pieces::joined(node, items, converted)
     }
 
     /// The wide subtree standing for `part` (its root is node 0), in one walk.
@@ -352,6 +346,7 @@ mod tests {
 
     use super::*;
     use crate::accel::bvh::{BinnedSah, BuildKind, BuildNode, BuildTree, Bvh};
+    use crate::accel::wide::node::{EMPTY, index_of, is_leaf};
 
     /// Stores primitive references, at most `max` per leaf.
     struct Refs {

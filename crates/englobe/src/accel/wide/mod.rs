@@ -44,6 +44,7 @@ pub mod node;
 pub mod packet;
 pub mod packet_kernels;
 pub mod packet_triangles;
+mod pieces;
 pub mod point_query;
 pub mod presplit;
 pub mod refit;

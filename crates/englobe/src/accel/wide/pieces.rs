@@ -1,0 +1,85 @@
+//! Wide subtrees made apart, in parallel, and stored together once.
+//!
+//! The conversion ([`super::convert()`]) and the direct build ([`super::build`](mod@super::build))
+//! make a large tree's top nodes first and their subtrees in parallel, each into nodes and leaf
+//! items of its own. Appending each subtree to its parent's nodes as soon as it is done would copy
+//! a node once for every parallel level above it (four, on a large tree; the root's copy on a
+//! single core). Instead the pieces are kept apart, in storage order, each with node and item
+//! references of its own, and copied once into the final array, in parallel, their references
+//! moved as they go.
+
+use super::convert::{LeafSink, WideLayout};
+use super::node::{EMPTY, LEAF, WideNode, index_of, is_leaf};
+use crate::accel::bvh::build::parallel::collect_indexed;
+
+/// A wide subtree as pieces, in the order they are stored: the first piece holds the subtree's
+/// root.
+pub(super) struct Pieces<K> {
+    pieces: Vec<Piece<K>>,
+    /// Wide nodes on the longest path from the subtree's root to a leaf.
+    depth: u32,
+}
+
+/// Nodes and leaf items whose references count from the piece's own first node and item.
+struct Piece<K> {
+    nodes: Vec<WideNode>,
+    items: K,
+    /// Interior slots of the piece's first node whose subtree starts `delta` pieces further on.
+    links: Vec<(usize, usize)>,
+}
+
+impl<K: LeafSink + Send + Sync> Pieces<K> {
+    /// A subtree made in one walk (its root is node 0), its leaves in `items`.
+    pub(super) fn walked(layout: WideLayout, items: K) -> Self {
+        Pieces { pieces: vec![Piece { nodes: layout.nodes, items, links: Vec::new() }], depth: layout.depth }
+    }
+
+    /// The subtree of `node` (its leaves in `items`), whose interior children, slot by slot in
+    /// increasing order, are `subtrees`.
+    pub(super) fn joined(node: WideNode, items: K, subtrees: Vec<(usize, Pieces<K>)>) -> Self {
+        let mut links = Vec::with_capacity(subtrees.len());
+        let mut pieces = Vec::with_capacity(1 + subtrees.iter().map(|(_, s)| s.pieces.len()).sum::<usize>());
+        pieces.push(Piece { nodes: vec![node], items, links: Vec::new() });
+        let mut depth = 1;
+        for (slot, subtree) in subtrees {
+            links.push((slot, pieces.len()));
+            depth = depth.max(1 + subtree.depth);
+            pieces.extend(subtree.pieces);
+        }
+        pieces[0].links = links;
+        Pieces { pieces, depth }
+    }
+
+    /// The subtree's nodes (its root is node 0), every node copied once, its leaf items appended
+    /// to `sink`'s in order.
+    pub(super) fn assemble(self, sink: &mut K) -> WideLayout {
+        // Where each piece's nodes and items start.
+        let mut first_node = Vec::with_capacity(self.pieces.len());
+        let mut first_item = Vec::with_capacity(self.pieces.len());
+        let mut total = 0u32;
+        let mut parts = Vec::with_capacity(self.pieces.len());
+        for piece in self.pieces {
+            first_node.push(total);
+            total += piece.nodes.len() as u32;
+            first_item.push(sink.join(piece.items));
+            parts.push((piece.nodes, piece.links));
+        }
+        let nodes = collect_indexed(total as usize, 1 << 10, |i| {
+            // The piece holding node `i`: the last one starting at or before it.
+            let p = first_node.partition_point(|&f| f as usize <= i) - 1;
+            let (nodes, links) = &parts[p];
+            let local = i - first_node[p] as usize;
+            let mut node = nodes[local];
+            for c in node.children.iter_mut().filter(|c| **c != EMPTY) {
+                *c = if is_leaf(*c) { LEAF | (index_of(*c) + first_item[p]) } else { *c + first_node[p] };
+            }
+            if local == 0 {
+                for &(slot, delta) in links {
+                    node.children[slot] = first_node[p + delta];
+                }
+            }
+            node
+        });
+        WideLayout { nodes, depth: self.depth }
+    }
+}
