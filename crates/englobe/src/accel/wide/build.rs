@@ -15,8 +15,9 @@
 //! node, whenever the splitter leaves ranges of at most [`ConvertOptions::collapse`] references
 //! alone (a leaf's references may otherwise come in another order).
 
-use super::convert::{ConvertOptions, LeafSink, PARALLEL_LEVELS, PARALLEL_MIN, WideLayout};
+use super::convert::{ConvertOptions, PARALLEL_LEVELS, PARALLEL_MIN};
 use super::node::{LEAF, MAX_LEAF_ITEMS, WIDTH, WideNode};
+use super::output::{LeafSink, WideLayout};
 use super::pieces::Pieces;
 use crate::Aabb;
 use crate::accel::bvh::build::parallel::{self, collect_indexed};

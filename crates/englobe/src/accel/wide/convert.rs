@@ -23,28 +23,10 @@
 
 pub use super::binary::BinaryTree;
 use super::node::{LEAF, MAX_LEAF_ITEMS, WIDTH, WideNode};
+pub use super::output::{LeafSink, WideLayout};
 use super::pieces::Pieces;
 use crate::Aabb;
 use crate::accel::bvh::build::parallel::collect_indexed;
-
-/// Where the leaves of a conversion go.
-pub trait LeafSink {
-    /// Most primitives one leaf may hold (at least 1); its items must then number at most
-    /// [`MAX_LEAF_ITEMS`].
-    fn max_prims(&self) -> usize;
-    /// Stores a leaf over the primitives `prims` (at most [`LeafSink::max_prims`]); returns the
-    /// index of its first item and its number of items.
-    fn leaf(&mut self, prims: &[u32]) -> (u32, u8);
-    /// An empty sink like this one, for a subtree converted on another thread.
-    fn split(&self) -> Self
-    where
-        Self: Sized;
-    /// Appends the items of `other` (a [`LeafSink::split`] of this sink) after this one's;
-    /// returns the index their first item now has.
-    fn join(&mut self, other: Self) -> u32
-    where
-        Self: Sized;
-}
 
 /// How binary nodes become wide nodes and leaves.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -52,16 +34,6 @@ pub struct ConvertOptions {
     /// Binary subtrees over at most this many primitives become one leaf (0 keeps the binary
     /// tree's leaves as they are).
     pub collapse: usize,
-}
-
-/// Wide nodes (the root is node 0; none for an empty tree) and the depth: wide nodes on the
-/// longest path from the root (0 for an empty tree).
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct WideLayout {
-    /// The nodes.
-    pub nodes: Vec<WideNode>,
-    /// Wide nodes on the longest path from the root to a leaf.
-    pub depth: u32,
 }
 
 /// A child being placed: a binary node, or a piece of a binary leaf too large for one reference.

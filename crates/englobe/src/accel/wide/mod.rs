@@ -16,7 +16,9 @@
 //! * [`node`]: the 256-byte node, child references, the scalar reference slab test.
 //! * [`convert`](mod@convert): binary tree ([`binary`]: either kind the builders give) to wide
 //!   nodes (largest boxes pulled up first, subtrees in parallel); [`build`](mod@build): the
-//!   same wide nodes built straight from the primitives' boxes, without the binary tree.
+//!   same wide nodes built straight from the primitives' boxes, without the binary tree;
+//!   [`output`]: what both produce (nodes, leaf sinks); `pieces` (inside the crate): their
+//!   parallel subtrees stored together once.
 //! * [`isa`]: the instruction sets, detected at run time; [`kernels`]: the slab test of eight
 //!   children for each; `dispatch` (inside the crate): the per-query choice.
 //! * [`traverse`]: the single-ray traversal, generic over kernels and leaves; [`packet`]: the
@@ -41,6 +43,7 @@ pub(crate) mod dispatch;
 pub mod isa;
 pub mod kernels;
 pub mod node;
+pub mod output;
 pub mod packet;
 pub mod packet_kernels;
 pub mod packet_triangles;

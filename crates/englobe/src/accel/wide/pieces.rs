@@ -8,8 +8,8 @@
 //! references of its own, and copied once into the final array, in parallel, their references
 //! moved as they go.
 
-use super::convert::{LeafSink, WideLayout};
 use super::node::{EMPTY, LEAF, WideNode, index_of, is_leaf};
+use super::output::{LeafSink, WideLayout};
 use crate::accel::bvh::build::parallel::collect_indexed;
 
 /// A wide subtree as pieces, in the order they are stored: the first piece holds the subtree's

@@ -1,0 +1,35 @@
+//! What the makers of wide trees produce: the nodes and their depth ([`WideLayout`]), and where
+//! the leaves go ([`LeafSink`]), shared by the conversion from a binary tree
+//! ([`super::convert()`]), the direct build ([`super::build`](mod@super::build)) and the storing
+//! of their parallel subtrees.
+
+use super::node::WideNode;
+
+/// Where the leaves of a conversion or a build go.
+pub trait LeafSink {
+    /// Most primitives one leaf may hold (at least 1); its items must then number at most
+    /// [`MAX_LEAF_ITEMS`](super::node::MAX_LEAF_ITEMS).
+    fn max_prims(&self) -> usize;
+    /// Stores a leaf over the primitives `prims` (at most [`LeafSink::max_prims`]); returns the
+    /// index of its first item and its number of items.
+    fn leaf(&mut self, prims: &[u32]) -> (u32, u8);
+    /// An empty sink like this one, for a subtree made on another thread.
+    fn split(&self) -> Self
+    where
+        Self: Sized;
+    /// Appends the items of `other` (a [`LeafSink::split`] of this sink) after this one's;
+    /// returns the index their first item now has.
+    fn join(&mut self, other: Self) -> u32
+    where
+        Self: Sized;
+}
+
+/// Wide nodes (the root is node 0; none for an empty tree) and the depth: wide nodes on the
+/// longest path from the root (0 for an empty tree).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct WideLayout {
+    /// The nodes.
+    pub nodes: Vec<WideNode>,
+    /// Wide nodes on the longest path from the root to a leaf.
+    pub depth: u32,
+}
