@@ -15,8 +15,8 @@
 //! node, whenever the splitter leaves ranges of at most [`ConvertOptions::collapse`] references
 //! alone (a leaf's references may otherwise come in another order).
 
-use super::convert::{ConvertOptions, PARALLEL_LEVELS, PARALLEL_MIN};
-use super::node::{LEAF, MAX_LEAF_ITEMS, WIDTH, WideNode};
+use super::convert::{ConvertOptions, PARALLEL_LEVELS, PARALLEL_MIN, greedy_slots, walk_stack};
+use super::node::{LEAF, MAX_LEAF_ITEMS, WideNode};
 use super::output::{LeafSink, WideLayout};
 use super::pieces::Pieces;
 use crate::Aabb;
@@ -136,27 +136,13 @@ impl<S: Splitter> Builder<'_, S> {
     /// opened in turn until eight slots are used or only leaves are left (the conversion's
     /// `fill_slots`, choice for choice).
     fn fill_slots(&self, refs: &mut [PrimRef], base: u32, part: Part, slots: &mut Vec<Part>, scratch: &mut S::Scratch) {
-        slots.clear();
-        if self.terminal(&part) {
-            slots.push(part);
-        } else {
-            slots.extend(self.open(refs, base, &part, scratch));
-        }
-        while slots.len() < WIDTH {
-            let widest = slots
-                .iter()
-                .enumerate()
-                .filter(|(_, p)| !self.terminal(p))
-                .max_by(|(_, a), (_, b)| {
-                    let area = a.bounds.surface_area().total_cmp(&b.bounds.surface_area());
-                    area.then(a.len().cmp(&b.len()))
-                })
-                .map(|(i, _)| i);
-            let Some(i) = widest else { break };
-            let [first, second] = self.open(refs, base, &slots[i], scratch);
-            slots[i] = first;
-            slots.insert(i + 1, second);
-        }
+        greedy_slots(
+            part,
+            slots,
+            |p| self.terminal(p),
+            |p| (p.bounds.surface_area(), p.len() as u32),
+            |p| self.open(refs, base, p, scratch),
+        );
     }
 
     /// The wide node standing for `part`: its leaf children stored through `sink`, its interior
@@ -242,21 +228,8 @@ impl<S: Splitter> Builder<'_, S> {
 
     /// The wide subtree standing for `part` (its root is node 0), from an explicit work stack.
     fn walk(&self, refs: &mut [PrimRef], base: u32, part: Part, sink: &mut impl LeafSink) -> WideLayout {
-        let mut nodes = vec![WideNode::EMPTY_NODE];
-        let mut depth = 1;
         let mut scratch = Scratch::default();
-        // (wide node to fill, the part it stands for, its level from 1)
-        let mut stack: Vec<(usize, Part, u32)> = vec![(0, part, 1)];
-        while let Some((here, part, level)) = stack.pop() {
-            depth = depth.max(level);
-            nodes[here] = self.node(refs, base, part, sink, &mut scratch, |_, p| {
-                let child = nodes.len();
-                nodes.push(WideNode::EMPTY_NODE);
-                stack.push((child, p, level + 1));
-                child as u32
-            });
-        }
-        WideLayout { nodes, depth }
+        walk_stack(part, |p, interior| self.node(refs, base, p, sink, &mut scratch, interior))
     }
 }
 
@@ -281,32 +254,8 @@ mod tests {
     use crate::accel::bvh::BinnedSah;
     use crate::accel::wide::binary::BinaryTree;
     use crate::accel::wide::convert::convert;
-    use crate::accel::wide::node::{EMPTY, index_of, is_leaf};
-
-    /// Stores primitive references, at most `max` per leaf.
-    struct Refs {
-        max: usize,
-        refs: Vec<u32>,
-    }
-
-    impl LeafSink for Refs {
-        fn max_prims(&self) -> usize {
-            self.max
-        }
-        fn leaf(&mut self, prims: &[u32]) -> (u32, u8) {
-            let first = self.refs.len() as u32;
-            self.refs.extend_from_slice(prims);
-            (first, prims.len() as u8)
-        }
-        fn split(&self) -> Self {
-            Refs { max: self.max, refs: Vec::new() }
-        }
-        fn join(&mut self, other: Self) -> u32 {
-            let first = self.refs.len() as u32;
-            self.refs.extend(other.refs);
-            first
-        }
-    }
+    use crate::accel::wide::convert::tests::Refs;
+    use crate::accel::wide::node::{EMPTY, WIDTH, index_of, is_leaf};
 
     /// Boxes of assorted sizes, scattered by a hash (and a few identical ones).
     fn scattered(n: usize) -> Vec<Aabb> {

@@ -173,29 +173,13 @@ impl<'a, T: BinaryTree> Walker<'a, T> {
     /// The children of the wide node standing for `part`: its halves, the widest non-leaf one
     /// opened in turn until eight slots are used or only leaves are left.
     fn fill_slots(&self, part: Part, slots: &mut Vec<Part>) {
-        slots.clear();
-        if self.terminal(&part) {
-            slots.push(part);
-        } else {
-            slots.extend(self.open(&part));
-        }
-        while slots.len() < WIDTH {
-            // Of equal boxes (pieces of one large leaf), the one with the most primitives: halving
-            // the largest keeps the pieces balanced instead of peeling them off one by one.
-            let widest = slots
-                .iter()
-                .enumerate()
-                .filter(|(_, p)| !self.terminal(p))
-                .max_by(|(_, a), (_, b)| {
-                    let area = self.bounds_of(a).surface_area().total_cmp(&self.bounds_of(b).surface_area());
-                    area.then(self.prims_in(a).cmp(&self.prims_in(b)))
-                })
-                .map(|(i, _)| i);
-            let Some(i) = widest else { break };
-            let [first, second] = self.open(&slots[i]);
-            slots[i] = first;
-            slots.insert(i + 1, second);
-        }
+        greedy_slots(
+            part,
+            slots,
+            |p| self.terminal(p),
+            |p| (self.bounds_of(p).surface_area(), self.prims_in(p)),
+            |p| self.open(p),
+        );
     }
 
     /// The wide node standing for `part`: its leaf children stored through `sink`, its interior
@@ -265,22 +249,68 @@ impl<'a, T: BinaryTree> Walker<'a, T> {
 
     /// The wide subtree standing for `part` (its root is node 0), in one walk.
     fn walk(&self, part: Part, sink: &mut impl LeafSink) -> WideLayout {
-        let mut nodes = vec![WideNode::EMPTY_NODE];
-        let mut depth = 1;
         let mut scratch = Scratch::default();
-        // (wide node to fill, the part it stands for, its level from 1)
-        let mut stack: Vec<(usize, Part, u32)> = vec![(0, part, 1)];
-        while let Some((here, part, level)) = stack.pop() {
-            depth = depth.max(level);
-            nodes[here] = self.node(part, sink, &mut scratch, |_, p| {
-                let child = nodes.len();
-                nodes.push(WideNode::EMPTY_NODE);
-                stack.push((child, p, level + 1));
-                child as u32
-            });
-        }
-        WideLayout { nodes, depth }
+        walk_stack(part, |p, interior| self.node(p, sink, &mut scratch, interior))
     }
+}
+
+/// The children of a wide node standing for `part`, in `slots`: `part` itself if it is
+/// `terminal`, else its two halves (`open`), the widest one that is not terminal opened in turn
+/// until eight slots are used or only terminal parts are left. `size` gives a part's surface
+/// area and primitives: of equal boxes (pieces of one large leaf) the one with the most
+/// primitives is opened, which keeps the pieces balanced instead of peeling them off one by one.
+pub(super) fn greedy_slots<P>(
+    part: P,
+    slots: &mut Vec<P>,
+    terminal: impl Fn(&P) -> bool,
+    size: impl Fn(&P) -> (f32, u32),
+    mut open: impl FnMut(&P) -> [P; 2],
+) {
+    slots.clear();
+    if terminal(&part) {
+        slots.push(part);
+    } else {
+        slots.extend(open(&part));
+    }
+    while slots.len() < WIDTH {
+        let widest = slots
+            .iter()
+            .enumerate()
+            .filter(|(_, p)| !terminal(p))
+            .max_by(|(_, a), (_, b)| {
+                let ((area_a, n_a), (area_b, n_b)) = (size(a), size(b));
+                area_a.total_cmp(&area_b).then(n_a.cmp(&n_b))
+            })
+            .map(|(i, _)| i);
+        let Some(i) = widest else { break };
+        let [first, second] = open(&slots[i]);
+        slots[i] = first;
+        slots.insert(i + 1, second);
+    }
+}
+
+/// The wide subtree standing for `part` (its root is node 0), from an explicit work stack (any
+/// depth): `node(part, interior)` makes the wide node standing for a part, giving each interior
+/// child the index `interior(slot, child)` returns; the children are made after, last slot
+/// first.
+pub(super) fn walk_stack<P>(
+    part: P,
+    mut node: impl FnMut(P, &mut dyn FnMut(usize, P) -> u32) -> WideNode,
+) -> WideLayout {
+    let mut nodes = vec![WideNode::EMPTY_NODE];
+    let mut depth = 1;
+    // (wide node to fill, the part it stands for, its level from 1)
+    let mut stack: Vec<(usize, P, u32)> = vec![(0, part, 1)];
+    while let Some((here, part, level)) = stack.pop() {
+        depth = depth.max(level);
+        nodes[here] = node(part, &mut |_, p| {
+            let child = nodes.len();
+            nodes.push(WideNode::EMPTY_NODE);
+            stack.push((child, p, level + 1));
+            child as u32
+        });
+    }
+    WideLayout { nodes, depth }
 }
 
 /// Working lists kept from node to node (a build converts tens of thousands of nodes).
@@ -313,7 +343,7 @@ fn gather(tree: &impl BinaryTree, part: &Part, out: &mut Vec<u32>, stack: &mut V
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use glam::Vec3;
 
     use super::*;
@@ -321,9 +351,9 @@ mod tests {
     use crate::accel::wide::node::{EMPTY, index_of, is_leaf};
 
     /// Stores primitive references, at most `max` per leaf.
-    struct Refs {
-        max: usize,
-        refs: Vec<u32>,
+    pub(crate) struct Refs {
+        pub(crate) max: usize,
+        pub(crate) refs: Vec<u32>,
     }
 
     impl LeafSink for Refs {
