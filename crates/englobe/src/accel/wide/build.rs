@@ -15,16 +15,15 @@
 //! node, whenever the splitter leaves ranges of at most [`ConvertOptions::collapse`] references
 //! alone (a leaf's references may otherwise come in another order).
 
-use super::convert::{ConvertOptions, PARALLEL_LEVELS, PARALLEL_MIN, greedy_slots, walk_stack};
+use super::convert::{
+    ConvertOptions, PARALLEL_LEVELS, PARALLEL_MIN as SUBTREES_PARALLEL_MIN, greedy_slots, walk_stack,
+};
 use super::node::{LEAF, MAX_LEAF_ITEMS, WideNode};
 use super::output::{LeafSink, WideLayout};
 use super::pieces::Pieces;
 use crate::Aabb;
 use crate::accel::bvh::build::parallel::{self, collect_indexed};
-use crate::accel::bvh::build::top_down::{PrimRef, Splitter, decide, range_bounds};
-
-/// Halves at least this large are made (bounded and split) in parallel.
-const SPLIT_PARALLEL_MIN: usize = 4096;
+use crate::accel::bvh::build::top_down::{PARALLEL_MIN, PrimRef, Splitter, decide, range_bounds};
 
 /// Builds the wide tree over `boxes` (primitive `i` has box `boxes[i]`), splitting ranges with
 /// `splitter` and storing leaves through `sink`; returns the nodes and the box around everything.
@@ -95,13 +94,13 @@ impl<S: Splitter> Builder<'_, S> {
         Part { start, end, bounds, kind }
     }
 
-    /// Whether a part is a leaf of the wide tree rather than an interior node.
+    /// Whether a part is a leaf of the wide tree rather than an interior node: a range the
+    /// splitter cut never is (ranges of at most `limit` references are never cut, see
+    /// [`Builder::part`]); a leaf or a piece is, if one wide leaf holds it.
     fn terminal(&self, p: &Part) -> bool {
-        let n = p.len();
         match p.kind {
-            Kind::Split(_) => n <= self.limit,
-            Kind::Leaf => n <= self.max_prims || n <= self.limit,
-            Kind::Piece => n <= self.max_prims,
+            Kind::Split(_) => false,
+            Kind::Leaf | Kind::Piece => p.len() <= self.max_prims,
         }
     }
 
@@ -112,7 +111,8 @@ impl<S: Splitter> Builder<'_, S> {
             Kind::Split(mid) => {
                 let range = &mut refs[(p.start - base) as usize..(p.end - base) as usize];
                 let (left, right) = range.split_at_mut((mid - p.start) as usize);
-                if left.len().min(right.len()) >= SPLIT_PARALLEL_MIN {
+                // Halves as large as the binary build's parallel subtrees are made in parallel too.
+                if left.len().min(right.len()) >= PARALLEL_MIN {
                     let (a, b) = parallel::join(
                         || self.part(left, p.start, &mut S::Scratch::default()),
                         || self.part(right, mid, &mut S::Scratch::default()),
@@ -173,9 +173,9 @@ impl<S: Splitter> Builder<'_, S> {
     }
 
     /// The wide subtree standing for `part` (its root is node 0), over `refs` (which start at
-    /// `base` in the whole list). A part over `PARALLEL_MIN` references or more has its node
-    /// made first, then its interior children's subtrees built in parallel and appended in slot
-    /// order, down to `levels` wide levels, as the conversion does.
+    /// `base` in the whole list). A part over `SUBTREES_PARALLEL_MIN` references or more has its
+    /// node made first, then its interior children's subtrees built in parallel and appended in
+    /// slot order, down to `levels` wide levels, as the conversion does.
     fn build<K: LeafSink + Send + Sync>(
         &self,
         refs: &mut [PrimRef],
@@ -184,7 +184,7 @@ impl<S: Splitter> Builder<'_, S> {
         sink: &mut K,
         levels: u32,
     ) -> WideLayout {
-        if levels == 0 || (part.len() as u32) < PARALLEL_MIN {
+        if levels == 0 || (part.len() as u32) < SUBTREES_PARALLEL_MIN {
             return self.walk(refs, base, part, sink);
         }
         self.pieces(refs, base, part, &*sink, levels).assemble(sink)
@@ -201,7 +201,7 @@ impl<S: Splitter> Builder<'_, S> {
         levels: u32,
     ) -> Pieces<K> {
         let mut items = template.split();
-        if levels == 0 || (part.len() as u32) < PARALLEL_MIN {
+        if levels == 0 || (part.len() as u32) < SUBTREES_PARALLEL_MIN {
             let layout = self.walk(refs, base, part, &mut items);
             return Pieces::walked(layout, items);
         }
@@ -303,7 +303,7 @@ mod tests {
     #[test]
     fn the_tree_is_the_binary_build_converted() {
         let triangles = BinnedSah { small_leaf: 4, parallel_partition: true, ..BinnedSah::default() };
-        for n in [0usize, 1, 2, 4, 5, 7, 9, 100, 5000, 10 * PARALLEL_MIN as usize] {
+        for n in [0usize, 1, 2, 4, 5, 7, 9, 100, 5000, 10 * SUBTREES_PARALLEL_MIN as usize] {
             let boxes = scattered(n);
             for max in [8, 16] {
                 agree(&triangles, &boxes, 4, max, true);

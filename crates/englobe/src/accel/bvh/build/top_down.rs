@@ -124,7 +124,7 @@ pub trait Splitter: Sync {
 }
 
 /// Subtrees at least this large are built in parallel (below it a task costs less than spawning).
-const PARALLEL_MIN: usize = 4096;
+pub const PARALLEL_MIN: usize = 4096;
 /// Levels of the bounded recursion that builds large subtrees in parallel; below it, or below
 /// [`PARALLEL_MIN`] references, the explicit work stack takes over.
 const PARALLEL_DEPTH: u32 = 40;
