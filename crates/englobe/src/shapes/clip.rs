@@ -85,16 +85,49 @@ impl Polygon {
         Polygon { vertices, len: 3 }
     }
 
+    /// An empty polygon, to be filled by [`Polygon::split_into`].
+    pub(crate) fn empty() -> Self {
+        Polygon { vertices: [DVec3::ZERO; POLYGON_ROOM], len: 0 }
+    }
+
     /// The parts of the polygon below and above the plane `x[axis] = plane` (boundaries
-    /// included); a side may be empty. The polygon must lie inside a box whose planes include
-    /// every plane it was cut by, which bounds its vertices.
-    pub(crate) fn split(&self, axis: usize, plane: f64) -> (Polygon, Polygon) {
+    /// included), written to `below` and `above`; a side may be empty. The polygon must lie
+    /// inside a box whose planes include every plane it was cut by, which bounds its vertices.
+    ///
+    /// One pass over the edges for both sides: each side's vertices are those, and in the order,
+    /// that [`clip_against`] gives it, and a crossing point both sides take is computed once.
+    pub(crate) fn split_into(&self, axis: usize, plane: f64, below: &mut Polygon, above: &mut Polygon) {
         let poly = &self.vertices[..self.len];
-        let mut below = Polygon { vertices: [DVec3::ZERO; POLYGON_ROOM], len: 0 };
-        let mut above = below;
-        below.len = clip_against(poly, &mut below.vertices, axis, plane, -1.0);
-        above.len = clip_against(poly, &mut above.vertices, axis, plane, 1.0);
-        (below, above)
+        let (mut b, mut a) = (0, 0);
+        let side = |p: &DVec3| {
+            let d = p.as_ref()[axis] - plane;
+            (d <= 0.0, d >= 0.0)
+        };
+        for (i, p) in poly.iter().enumerate() {
+            let q = &poly[if i + 1 == poly.len() { 0 } else { i + 1 }];
+            let ((p_below, p_above), (q_below, q_above)) = (side(p), side(q));
+            // A convex polygon cut by a plane gains at most one vertex; each side has room.
+            if p_below && b < POLYGON_ROOM {
+                below.vertices[b] = *p;
+                b += 1;
+            }
+            if p_above && a < POLYGON_ROOM {
+                above.vertices[a] = *p;
+                a += 1;
+            }
+            if p_below != q_below || p_above != q_above {
+                let x = crossing(p, q, axis, plane);
+                if p_below != q_below && b < POLYGON_ROOM {
+                    below.vertices[b] = x;
+                    b += 1;
+                }
+                if p_above != q_above && a < POLYGON_ROOM {
+                    above.vertices[a] = x;
+                    a += 1;
+                }
+            }
+        }
+        (below.len, above.len) = (b, a);
     }
 
     /// The polygon's bounds rounded outward to `f32` ([`Aabb::EMPTY`] if it is empty).
@@ -118,27 +151,32 @@ impl Polygon {
 /// `sign * (x[axis] - plane) >= 0`, written to `out`; returns its number of vertices.
 fn clip_against(poly: &[DVec3], out: &mut [DVec3], axis: usize, plane: f64, sign: f64) -> usize {
     let mut len = 0;
-    let inside = |p: &DVec3| sign * (p[axis] - plane) >= 0.0;
+    let inside = |p: &DVec3| sign * (p.as_ref()[axis] - plane) >= 0.0;
     for (i, p) in poly.iter().enumerate() {
-        let q = &poly[(i + 1) % poly.len()];
+        let q = &poly[if i + 1 == poly.len() { 0 } else { i + 1 }];
         let (p_in, q_in) = (inside(p), inside(q));
         // A convex polygon cut by a plane gains at most one vertex; `out` has room for that.
         if p_in && len < out.len() {
             out[len] = *p;
             len += 1;
         }
-        if p_in != q_in {
-            // The edge crosses the plane strictly: the crossing point, put exactly on the plane.
-            let s = (plane - p[axis]) / (q[axis] - p[axis]);
-            let mut x = *p + (*q - *p) * s;
-            x[axis] = plane;
-            if len < out.len() {
-                out[len] = x;
-                len += 1;
-            }
+        if p_in != q_in && len < out.len() {
+            out[len] = crossing(p, q, axis, plane);
+            len += 1;
         }
     }
     len
+}
+
+/// Where the edge from `p` to `q`, which crosses the plane `x[axis] = plane` (strictly, or from a
+/// vertex on it), meets it: put exactly on the plane.
+#[inline(always)]
+fn crossing(p: &DVec3, q: &DVec3, axis: usize, plane: f64) -> DVec3 {
+    let (pa, qa) = (p.as_ref()[axis], q.as_ref()[axis]);
+    let s = (plane - pa) / (qa - pa);
+    let mut x = *p + (*q - *p) * s;
+    x.as_mut()[axis] = plane;
+    x
 }
 
 /// The largest `f32` not above `x`.
@@ -242,5 +280,40 @@ mod tests {
         assert_eq!(round_up(-0.5), -0.5);
         assert!(round_down(-1e-50) < 0.0 && round_up(1e-50) > 0.0);
         assert!(round_down(-third) <= -third as f32);
+    }
+
+    #[test]
+    fn one_pass_split_gives_each_side_what_clipping_it_alone_gives() {
+        // Triangles cut again and again, by planes through their vertices as often as not, so
+        // that vertices on the plane (which both sides keep) and flat pieces occur.
+        let mut rng = Pcg32::seed_from_u64(0x5b11_7000);
+        let mut both_sides = 0;
+        for _ in 0..5_000 {
+            let mut p =
+                || Vec3::new(rng.random_range(-4..=4) as f32, rng.random_range(-4..=4) as f32, rng.random::<f32>());
+            let mut part = Polygon::triangle([p(), p(), p()]);
+            for _ in 0..4 {
+                let axis = rng.random_range(0..3);
+                let plane = if rng.random() {
+                    part.vertices[rng.random_range(0..part.len.max(1))].as_ref()[axis]
+                } else {
+                    rng.random_range(-4.0..4.0)
+                };
+                let (mut below, mut above) = (Polygon::empty(), Polygon::empty());
+                part.split_into(axis, plane, &mut below, &mut above);
+                for (side, sign) in [(&below, -1.0), (&above, 1.0)] {
+                    let mut alone = [DVec3::ZERO; POLYGON_ROOM];
+                    let len = clip_against(&part.vertices[..part.len], &mut alone, axis, plane, sign);
+                    let bits = |v: &[DVec3]| v.iter().map(|p| p.to_array().map(f64::to_bits)).collect::<Vec<_>>();
+                    assert_eq!(bits(&side.vertices[..side.len]), bits(&alone[..len]), "axis {axis} plane {plane}");
+                }
+                both_sides += (below.len > 0 && above.len > 0) as u32;
+                part = if rng.random() && below.len > 0 { below } else { above };
+                if part.len == 0 {
+                    break;
+                }
+            }
+        }
+        assert!(both_sides > 5_000, "{both_sides}");
     }
 }

@@ -165,7 +165,8 @@ fn cut(part: &Polygon, b: Aabb, pieces: usize, scene: &Aabb, out: &mut Vec<Aabb>
         out.push(b);
         return;
     };
-    let (below, above) = part.split(axis, plane as f64);
+    let (mut below, mut above) = (Polygon::empty(), Polygon::empty());
+    part.split_into(axis, plane as f64, &mut below, &mut above);
     // Rounded outward, each side's bounds stay within the part's.
     let (lb, ab) = (below.bounds().intersection(&b), above.bounds().intersection(&b));
     if lb.is_empty() || ab.is_empty() {
