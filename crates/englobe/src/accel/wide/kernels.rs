@@ -177,7 +177,9 @@ mod tests {
                 }
                 let origin = Vec3::new(pick(&values), pick(&values), pick(&values)) * 1.5;
                 let dir = Vec3::new(pick(&dirs), pick(&dirs), pick(&dirs));
-                hits += check(isa, &node, &Ray::segment(origin, dir, 0.0, t_max));
+                // Negative starts too, so that entries of both zeros' signs compete.
+                let t_min = [0.0, -0.0, -1.0][next(3) as usize];
+                hits += check(isa, &node, &Ray::segment(origin, dir, t_min, t_max));
             }
             // About one box in fourteen is entered: enough of both outcomes.
             assert!(hits > 3_000, "{isa}: {hits}");
