@@ -20,7 +20,7 @@ use super::convert::{
 };
 use super::node::{LEAF, MAX_LEAF_ITEMS, WideNode};
 use super::output::{LeafSink, WideLayout};
-use super::pieces::Pieces;
+use super::pieces::{Pieces, Store};
 use crate::Aabb;
 use crate::accel::bvh::build::parallel::{self, collect_indexed};
 use crate::accel::bvh::build::top_down::{PARALLEL_MIN, PrimRef, Splitter, decide, range_bounds};
@@ -187,23 +187,26 @@ impl<S: Splitter> Builder<'_, S> {
         if levels == 0 || (part.len() as u32) < SUBTREES_PARALLEL_MIN {
             return self.walk(refs, base, part, sink);
         }
-        self.pieces(refs, base, part, &*sink, levels).assemble(sink)
+        let store = Store::for_prims(part.len());
+        self.pieces(refs, base, part, &*sink, &store, levels).assemble(store, sink)
     }
 
     /// [`Builder::build`]'s subtree as pieces, each with leaf items of its own (made by
-    /// `template`'s [`LeafSink::split`]), stored together at the end.
+    /// `template`'s [`LeafSink::split`]) and nodes kept in `store`, stored together at the end.
+    #[allow(clippy::too_many_arguments)]
     fn pieces<K: LeafSink + Send + Sync>(
         &self,
         refs: &mut [PrimRef],
         base: u32,
         part: Part,
         template: &K,
+        store: &Store<K>,
         levels: u32,
     ) -> Pieces<K> {
         let mut items = template.split();
         if levels == 0 || (part.len() as u32) < SUBTREES_PARALLEL_MIN {
             let layout = self.walk(refs, base, part, &mut items);
-            return Pieces::walked(layout, items);
+            return Pieces::walked(layout, items, store);
         }
         let mut scratch = Scratch::default();
         let mut subtrees = Vec::new();
@@ -221,8 +224,9 @@ impl<S: Splitter> Builder<'_, S> {
             jobs.push((slot, p, mine));
             (rest, at) = (tail, p.end);
         }
-        let built =
-            parallel::map_each(jobs, |(slot, p, mine)| (slot, self.pieces(mine, p.start, p, template, levels - 1)));
+        let built = parallel::map_each(jobs, |(slot, p, mine)| {
+            (slot, self.pieces(mine, p.start, p, template, store, levels - 1))
+        });
         Pieces::joined(node, items, built)
     }
 

@@ -24,7 +24,7 @@
 pub use super::binary::BinaryTree;
 use super::node::{LEAF, MAX_LEAF_ITEMS, WIDTH, WideNode};
 pub use super::output::{LeafSink, WideLayout};
-use super::pieces::Pieces;
+use super::pieces::{Pieces, Store};
 use crate::Aabb;
 use crate::accel::bvh::build::parallel::collect_indexed;
 
@@ -221,19 +221,20 @@ impl<'a, T: BinaryTree> Walker<'a, T> {
         if levels == 0 || self.prims_in(&part) < PARALLEL_MIN {
             return self.walk(part, sink);
         }
-        self.pieces(part, &*sink, levels).assemble(sink)
+        let store = Store::for_prims(self.prims_in(&part) as usize);
+        self.pieces(part, &*sink, &store, levels).assemble(store, sink)
     }
 
     /// [`Walker::convert`]'s subtree as pieces, each with leaf items of its own (made by
-    /// `template`'s [`LeafSink::split`]), stored together at the end.
-    fn pieces<S: LeafSink + Send + Sync>(&self, part: Part, template: &S, levels: u32) -> Pieces<S>
+    /// `template`'s [`LeafSink::split`]) and nodes kept in `store`, stored together at the end.
+    fn pieces<S: LeafSink + Send + Sync>(&self, part: Part, template: &S, store: &Store<S>, levels: u32) -> Pieces<S>
     where
         T: Sync,
     {
         let mut items = template.split();
         if levels == 0 || self.prims_in(&part) < PARALLEL_MIN {
             let layout = self.walk(part, &mut items);
-            return Pieces::walked(layout, items);
+            return Pieces::walked(layout, items, store);
         }
         let mut scratch = Scratch::default();
         // The interior children are placed once their subtrees are converted.
@@ -242,8 +243,9 @@ impl<'a, T: BinaryTree> Walker<'a, T> {
             subtrees.push((slot, p));
             0
         });
-        let converted =
-            collect_indexed(subtrees.len(), 1, |i| (subtrees[i].0, self.pieces(subtrees[i].1, template, levels - 1)));
+        let converted = collect_indexed(subtrees.len(), 1, |i| {
+            (subtrees[i].0, self.pieces(subtrees[i].1, template, store, levels - 1))
+        });
         Pieces::joined(node, items, converted)
     }
 
@@ -365,12 +367,16 @@ pub(super) mod tests {
             self.refs.extend_from_slice(prims);
             (first, prims.len() as u8)
         }
+        type Item = u32;
         fn split(&self) -> Self {
             Refs { max: self.max, refs: Vec::new() }
         }
-        fn join(&mut self, other: Self) -> u32 {
+        fn into_items(self) -> Vec<u32> {
+            self.refs
+        }
+        fn append(&mut self, items: &[u32]) -> u32 {
             let first = self.refs.len() as u32;
-            self.refs.extend(other.refs);
+            self.refs.extend_from_slice(items);
             first
         }
     }

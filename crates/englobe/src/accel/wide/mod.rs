@@ -33,6 +33,7 @@
 //!   to rebuild instead.
 //! * [`validate`]: the invariants of both, checked.
 
+mod arena;
 pub mod binary;
 pub mod box_query;
 pub mod build;
@@ -96,13 +97,19 @@ impl LeafSink for References {
         (first, prims.len() as u8)
     }
 
+    type Item = u32;
+
     fn split(&self) -> Self {
         References(Vec::new())
     }
 
-    fn join(&mut self, other: Self) -> u32 {
+    fn into_items(self) -> Vec<u32> {
+        self.0
+    }
+
+    fn append(&mut self, items: &[u32]) -> u32 {
         let first = self.0.len() as u32;
-        self.0.extend(other.0);
+        self.0.extend_from_slice(items);
         first
     }
 }

@@ -13,15 +13,19 @@ pub trait LeafSink {
     /// Stores a leaf over the primitives `prims` (at most [`LeafSink::max_prims`]); returns the
     /// index of its first item and its number of items.
     fn leaf(&mut self, prims: &[u32]) -> (u32, u8);
+    /// What leaves are stored as (primitive references, blocks of triangles).
+    type Item: Copy + Send + Sync;
     /// An empty sink like this one, for a subtree made on another thread.
     fn split(&self) -> Self
     where
         Self: Sized;
-    /// Appends the items of `other` (a [`LeafSink::split`] of this sink) after this one's;
-    /// returns the index their first item now has.
-    fn join(&mut self, other: Self) -> u32
+    /// The items stored so far, in order (those of a [`LeafSink::split`], handed over).
+    fn into_items(self) -> Vec<Self::Item>
     where
         Self: Sized;
+    /// Appends `items` (a [`LeafSink::split`]'s) after this sink's; returns the index their
+    /// first item now has.
+    fn append(&mut self, items: &[Self::Item]) -> u32;
 }
 
 /// Wide nodes (the root is node 0; none for an empty tree) and the depth: wide nodes on the

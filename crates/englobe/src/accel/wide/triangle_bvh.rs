@@ -125,13 +125,19 @@ impl LeafSink for Blocks<'_> {
         (first, (self.blocks.len() as u32 - first) as u8)
     }
 
+    type Item = [u32; LANES];
+
     fn split(&self) -> Self {
         Blocks { ids: self.ids, blocks: Vec::new(), leaf_ids: Vec::new() }
     }
 
-    fn join(&mut self, other: Self) -> u32 {
+    fn into_items(self) -> Vec<[u32; LANES]> {
+        self.blocks
+    }
+
+    fn append(&mut self, items: &[[u32; LANES]]) -> u32 {
         let first = self.blocks.len() as u32;
-        self.blocks.extend(other.blocks);
+        self.blocks.extend_from_slice(items);
         first
     }
 }
