@@ -32,10 +32,26 @@ where
     S: Splitter,
     K: LeafSink + Send + Sync,
 {
-    if boxes.is_empty() {
+    build_wide_with(splitter, boxes.len(), |i| boxes[i], options, sink)
+}
+
+/// [`build_wide`] over `count` primitives whose boxes `box_of` gives (each asked for once), for a
+/// caller that holds them in another form than a list of boxes.
+pub fn build_wide_with<S, K>(
+    splitter: &S,
+    count: usize,
+    box_of: impl Fn(usize) -> Aabb + Sync,
+    options: ConvertOptions,
+    sink: &mut K,
+) -> (WideLayout, Aabb)
+where
+    S: Splitter,
+    K: LeafSink + Send + Sync,
+{
+    if count == 0 {
         return (WideLayout::default(), Aabb::EMPTY);
     }
-    let mut refs = collect_indexed(boxes.len(), 1 << 14, |i| PrimRef::new(&boxes[i], i as u32));
+    let mut refs = collect_indexed(count, 1 << 14, |i| PrimRef::new(&box_of(i), i as u32));
     let max_prims = sink.max_prims().clamp(1, MAX_LEAF_ITEMS);
     let builder = Builder { splitter, max_prims, limit: options.collapse.min(max_prims) };
     let root = builder.part(&mut refs, 0, &mut S::Scratch::default());

@@ -48,6 +48,9 @@ pub const MAX_PIECES: usize = 16;
 /// scene's side). Chosen on the bunny, the ogre and the Sponza: see the module's documentation.
 pub const MIN_WASTE_SHARE: f32 = 1.0 / 2048.0;
 
+/// Triangles per task in the presplit's passes over all of them.
+const CHUNK: usize = 1 << 14;
+
 /// The boxes the build sees and, for each, the triangle (an index into the caller's list) it
 /// belongs to.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -85,18 +88,38 @@ impl TriangleBox {
 /// [`MIN_WASTE_SHARE`] of the scene's area are cut. The triangles are cut in parallel; the
 /// fragments come in triangle order, whatever the threads.
 pub fn presplit(triangles: &[TriangleBox], triangle: impl Fn(u32) -> [Vec3; 3] + Sync, budget: f32) -> Fragments {
+    presplit_cuts(triangles, triangle, budget).unwrap_or_else(|| Fragments {
+        boxes: collect_indexed(triangles.len(), CHUNK, |i| triangles[i].bounds),
+        owner: collect_indexed(triangles.len(), CHUNK, |i| i as u32),
+    })
+}
+
+/// [`presplit`], or `None` when it would cut no triangle: the fragments would then be the
+/// triangles' own boxes, which a caller that has them need not copy (hundreds of megabytes on a
+/// scene of millions of triangles).
+pub fn presplit_cuts(
+    triangles: &[TriangleBox],
+    triangle: impl Fn(u32) -> [Vec3; 3] + Sync,
+    budget: f32,
+) -> Option<Fragments> {
     let count = triangles.len();
     // References stay within what a build may hold (its bins count them in `i32` lanes).
     let extra = ((budget.max(0.0) * count as f32) as usize).min(MAX_PRIMITIVES.saturating_sub(count));
-    let whole =
-        || Fragments { boxes: triangles.iter().map(|t| t.bounds).collect(), owner: (0..count as u32).collect() };
     if extra == 0 {
-        return whole();
+        return None;
     }
-    let (scene, total) =
-        triangles.iter().fold((Aabb::EMPTY, 0f64), |(s, w), t| (s.union(&t.bounds), w + t.waste as f64));
+    // The passes over every triangle go in fixed chunks, in parallel: the scene's box, the sum
+    // and the list of the triangles to cut come out the same whatever the threads.
+    let chunks = count.div_ceil(CHUNK);
+    let chunk = |c: usize| c * CHUNK..((c + 1) * CHUNK).min(count);
+    let sum = |(s, w): (Aabb, f64), (b, x): (Aabb, f64)| (s.union(&b), w + x);
+    let (scene, total) = collect_indexed(chunks, 1, |c| {
+        triangles[chunk(c)].iter().map(|t| (t.bounds, t.waste as f64)).fold((Aabb::EMPTY, 0.0), sum)
+    })
+    .into_iter()
+    .fold((Aabb::EMPTY, 0.0), sum);
     if !(total > 0.0) || !scene.is_finite() {
-        return whole();
+        return None;
     }
     // The budget is shared in proportion to every triangle's waste; those below the floor take
     // no part of it.
@@ -106,28 +129,31 @@ pub fn presplit(triangles: &[TriangleBox], triangle: impl Fn(u32) -> [Vec3; 3] +
         let waste = triangles[i].waste;
         if waste < floor { 1 } else { (1 + (waste as f64 * share) as usize).min(MAX_PIECES) }
     };
-    let cut_ones: Vec<u32> = (0..count as u32).filter(|&i| pieces(i as usize) > 1).collect();
+    let cut_ones: Vec<u32> =
+        collect_indexed(chunks, 1, |c| chunk(c).filter(|&i| pieces(i) > 1).map(|i| i as u32).collect::<Vec<_>>())
+            .concat();
+    if cut_ones.is_empty() {
+        return None;
+    }
     let cut_boxes: Vec<Vec<Aabb>> = collect_indexed(cut_ones.len(), 64, |k| {
         let i = cut_ones[k];
         let mut out = Vec::with_capacity(pieces(i as usize));
         cut(&Polygon::triangle(triangle(i)), triangles[i as usize].bounds, pieces(i as usize), &scene, &mut out);
         out
     });
+    // The triangles left whole go in runs, between the cut ones' fragments.
     let mut out = Fragments { boxes: Vec::with_capacity(count + extra), owner: Vec::with_capacity(count + extra) };
-    let mut next_cut = cut_ones.iter().zip(&cut_boxes).peekable();
-    for (i, t) in triangles.iter().enumerate() {
-        match next_cut.next_if(|(c, _)| **c == i as u32) {
-            Some((_, parts)) => {
-                out.boxes.extend_from_slice(parts);
-                out.owner.extend(std::iter::repeat_n(i as u32, parts.len()));
-            }
-            None => {
-                out.boxes.push(t.bounds);
-                out.owner.push(i as u32);
-            }
-        }
+    let mut whole_from = 0;
+    for (&i, parts) in cut_ones.iter().zip(&cut_boxes) {
+        out.boxes.extend(triangles[whole_from..i as usize].iter().map(|t| t.bounds));
+        out.owner.extend(whole_from as u32..i);
+        out.boxes.extend_from_slice(parts);
+        out.owner.extend(std::iter::repeat_n(i, parts.len()));
+        whole_from = i as usize + 1;
     }
-    out
+    out.boxes.extend(triangles[whole_from..].iter().map(|t| t.bounds));
+    out.owner.extend(whole_from as u32..count as u32);
+    Some(out)
 }
 
 /// The coarsest plane of the power-of-two grid over `scene` along `axis` strictly inside

@@ -9,16 +9,16 @@
 
 use glam::Vec3;
 
-use super::build::build_wide;
+use super::build::build_wide_with;
 use super::convert::{ConvertOptions, LeafSink};
 use super::dispatch;
 use super::isa::{Isa, IsaUnavailable};
 use super::node::{NodeRay, WideNode, may_enter, reach};
-use super::presplit::{TriangleBox, presplit};
+use super::presplit::{TriangleBox, presplit_cuts};
 use super::traverse::Leaves;
 use super::triangles::{LANES, TriBlock, TriRay, UNUSED, intersect_block, is_storable};
 use crate::accel::bvh::BinnedSah;
-use crate::accel::bvh::build::parallel::collect_indexed;
+use crate::accel::bvh::build::parallel::{collect_indexed, map_chunks};
 use crate::accel::{Counters, Hit, HitFilter, LEAF_SIZE_BUCKETS, MAX_PRIMITIVES, NoFilter, StructureStats};
 use crate::geom::prefetch::prefetch;
 use crate::shapes::{MeshError, TriangleMesh, check_arrays};
@@ -97,8 +97,9 @@ pub(super) fn triangle_of<'a>(
 /// Packs leaves into blocks of four triangles: names each block's triangles as the conversion
 /// meets its leaves; the blocks themselves are filled afterwards, in parallel ([`Blocks::fill`]).
 struct Blocks<'a> {
-    /// The triangle of each of the build's boxes (several boxes name one cut triangle).
-    ids: &'a [u32],
+    /// The triangle of each of the build's boxes (several boxes name one cut triangle); `None`
+    /// when box `i` is triangle `i`.
+    ids: Option<&'a [u32]>,
     /// Each block's triangles, [`UNUSED`] in the lanes beyond them.
     blocks: Vec<[u32; LANES]>,
     /// The leaf's triangles, each once.
@@ -113,7 +114,7 @@ impl LeafSink for Blocks<'_> {
     fn leaf(&mut self, prims: &[u32]) -> (u32, u8) {
         let first = self.blocks.len() as u32;
         self.leaf_ids.clear();
-        self.leaf_ids.extend(prims.iter().map(|&p| self.ids[p as usize]));
+        self.leaf_ids.extend(prims.iter().map(|&p| self.ids.map_or(p, |ids| ids[p as usize])));
         // Pieces of one cut triangle may meet in a leaf: it is stored there once.
         self.leaf_ids.sort_unstable();
         self.leaf_ids.dedup();
@@ -210,28 +211,40 @@ impl TriangleBvh {
             }
         });
         // The triangles kept, by index, unless all are (then index `i` is triangle `i`).
-        let ids: Option<Vec<u32>> = (!described.iter().all(|t| t.bounds.is_finite()))
-            .then(|| (0..count as u32).filter(|&i| described[i as usize].bounds.is_finite()).collect());
+        let all_kept =
+            map_chunks(&described, 1 << 14, |c| c.iter().all(|t| t.bounds.is_finite())).into_iter().all(|a| a);
+        let ids: Option<Vec<u32>> =
+            (!all_kept).then(|| (0..count as u32).filter(|&i| described[i as usize].bounds.is_finite()).collect());
         let kept: Vec<TriangleBox> = match &ids {
             Some(ids) => ids.iter().map(|&i| described[i as usize]).collect(),
             None => described,
         };
         let id = |k: u32| ids.as_ref().map_or(k, |ids| ids[k as usize]);
         let budget = options.presplit_percent as f32 / 100.0;
-        let fragments = presplit(&kept, |k| triangle(id(k)), budget);
-        let (stored, cut) = (kept.len(), fragments.boxes.len() > kept.len());
-        drop(kept);
-        let owners: Vec<u32> = match &ids {
-            Some(_) => fragments.owner.iter().map(|&k| id(k)).collect(),
-            None => fragments.owner,
+        // The fragments, if any triangle is cut; else the build reads the triangles' boxes.
+        let fragments = presplit_cuts(&kept, |k| triangle(id(k)), budget);
+        let stored = kept.len();
+        let cut = fragments.as_ref().is_some_and(|f| f.boxes.len() > stored);
+        // The triangle each box of the build names, unless it is the box's own index.
+        let mapped: Option<Vec<u32>> = match (&fragments, &ids) {
+            (Some(f), Some(_)) => Some(f.owner.iter().map(|&k| id(k)).collect()),
+            _ => None,
         };
-        let mut sink = Blocks { ids: &owners, blocks: Vec::new(), leaf_ids: Vec::new() };
+        let owners = mapped.as_deref().or(fragments.as_ref().map(|f| &f.owner[..])).or(ids.as_deref());
+        let mut sink = Blocks { ids: owners, blocks: Vec::new(), leaf_ids: Vec::new() };
+        let count_built = fragments.as_ref().map_or(stored, |f| f.boxes.len());
         // Wide nodes straight from the boxes: no binary tree in between.
-        let (layout, bounds) =
-            build_wide(&options.builder, &fragments.boxes, ConvertOptions { collapse: options.collapse }, &mut sink);
+        let box_of = |i: usize| match &fragments {
+            Some(f) => f.boxes[i],
+            None => kept[i].bounds,
+        };
+        let options_wide = ConvertOptions { collapse: options.collapse };
+        let (layout, bounds) = build_wide_with(&options.builder, count_built, box_of, options_wide, &mut sink);
+        drop(kept);
+        let blocks = sink.fill(&triangle);
         TriangleBvh {
             nodes: layout.nodes,
-            blocks: sink.fill(&triangle),
+            blocks,
             depth: layout.depth,
             bounds,
             stored,
