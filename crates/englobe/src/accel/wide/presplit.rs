@@ -74,7 +74,10 @@ pub struct TriangleBox {
 }
 
 impl TriangleBox {
-    /// The box of triangle `v` and its waste.
+    /// The box of triangle `v` and its waste. Inlined: the builds that call it once per triangle
+    /// are generic over how triangles are fetched, so they are compiled in the caller's crate,
+    /// where a plain function of this one is a call that LLVM cannot inline.
+    #[inline]
     pub fn of(v: &[Vec3; 3]) -> Self {
         let bounds = Aabb::from_points(*v);
         let n = (v[1] - v[0]).cross(v[2] - v[0]).abs();
