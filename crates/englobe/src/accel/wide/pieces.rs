@@ -113,3 +113,85 @@ impl<K: LeafSink + Send + Sync> Pieces<K> {
         WideLayout { nodes, depth: self.depth }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use glam::Vec3;
+
+    use super::*;
+    use crate::Aabb;
+
+    /// Stores each leaf's primitives as its items.
+    struct Items(Vec<u32>);
+
+    impl LeafSink for Items {
+        type Item = u32;
+        fn max_prims(&self) -> usize {
+            8
+        }
+        fn leaf(&mut self, prims: &[u32]) -> (u32, u8) {
+            let first = self.0.len() as u32;
+            self.0.extend_from_slice(prims);
+            (first, prims.len() as u8)
+        }
+        fn split(&self) -> Self {
+            Items(Vec::new())
+        }
+        fn into_items(self) -> Vec<u32> {
+            self.0
+        }
+        fn append(&mut self, items: &[u32]) -> u32 {
+            let first = self.0.len() as u32;
+            self.0.extend_from_slice(items);
+            first
+        }
+    }
+
+    /// A walked piece of two nodes: its root has a leaf of `prims[0]` in slot 0 and node 1 in
+    /// slot 1, which has a leaf of `prims[1]` in slot 3.
+    fn walked(prims: [&[u32]; 2], store: &Store<Items>) -> Pieces<Items> {
+        let mut items = Items(Vec::new());
+        let unit = Aabb::new(Vec3::ZERO, Vec3::ONE);
+        let mut root = WideNode::EMPTY_NODE;
+        let (first, count) = items.leaf(prims[0]);
+        root.set_child(0, &unit, LEAF | first, count);
+        root.set_child(1, &unit, 1, 0);
+        let mut child = WideNode::EMPTY_NODE;
+        let (first, count) = items.leaf(prims[1]);
+        child.set_child(3, &unit, LEAF | first, count);
+        Pieces::walked(WideLayout { nodes: vec![root, child], depth: 2 }, items, store)
+    }
+
+    /// A root with a leaf of 9, 9 in slot 1 and the walked pieces in slots 0 and 2, assembled
+    /// after a sink holding one item already.
+    fn assembled(store: Store<Items>) -> (WideLayout, Vec<u32>) {
+        let unit = Aabb::new(Vec3::ZERO, Vec3::ONE);
+        let mut items = Items(Vec::new());
+        let mut root = WideNode::EMPTY_NODE;
+        let (first, count) = items.leaf(&[9, 9]);
+        root.set_child(1, &unit, LEAF | first, count);
+        let a = walked([&[1, 2], &[3]], &store);
+        let b = walked([&[4], &[5, 6, 7]], &store);
+        let pieces = Pieces::joined(root, items, vec![(0, a), (2, b)]);
+        let mut sink = Items(vec![0]);
+        let layout = pieces.assemble(store, &mut sink);
+        (layout, sink.0)
+    }
+
+    #[test]
+    fn pieces_assemble_the_same_wherever_they_waited() {
+        let roomy = assembled(Store { nodes: Arena::with_capacity(64), items: Arena::with_capacity(64) });
+        let (layout, items) = &roomy;
+        assert_eq!(layout.depth, 3);
+        assert_eq!(items, &[0, 9, 9, 1, 2, 3, 4, 5, 6, 7]);
+        let [root, a, a1, b, b1] = layout.nodes[..] else { panic!("{} nodes", layout.nodes.len()) };
+        assert_eq!(root.children[..3], [1, LEAF | 1, 3]);
+        assert_eq!((&a.children[..2], a1.children[3]), (&[LEAF | 3, 2][..], LEAF | 5));
+        assert_eq!((&b.children[..2], b1.children[3]), (&[LEAF | 6, 4][..], LEAF | 7));
+        // No room at all, and room for the first piece only: its own vectors keep the rest.
+        for (nodes, items) in [(0, 0), (2, 3), (3, 2)] {
+            let store = Store { nodes: Arena::with_capacity(nodes), items: Arena::with_capacity(items) };
+            assert_eq!(assembled(store), roomy, "room for {nodes} nodes and {items} items");
+        }
+    }
+}

@@ -284,6 +284,7 @@ mod tests {
         assert!(waste < scene.surface_area() * MIN_WASTE_SHARE);
         let f = presplit(&input, |i| tris[i as usize], 0.4);
         assert_eq!(f.boxes, boxes);
+        assert_eq!(presplit_cuts(&input, |i| tris[i as usize], 0.4), None);
         // The same triangle grown to a fifth of the scene is cut.
         tris[0] = [Vec3::ZERO, Vec3::splat(20.0), Vec3::new(20.0, 18.0, 20.0)];
         let (input, _) = described(&tris);
@@ -310,6 +311,39 @@ mod tests {
         let f = presplit(&input, |i| tris[i as usize], 0.0);
         assert_eq!(f.boxes, boxes);
         assert_eq!(f.owner, vec![0, 1, 2, 3]);
+        assert_eq!(presplit_cuts(&input, |i| tris[i as usize], 0.0), None);
+    }
+
+    #[test]
+    fn cut_triangles_in_several_chunks_keep_the_others_whole_and_in_order() {
+        // Small triangles over three chunks' worth, and large diagonal ones among them: at the
+        // start, inside the second chunk and last.
+        let n = 2 * CHUNK + 100;
+        let large = [0, CHUNK + 7, n - 1];
+        let tris: Vec<[Vec3; 3]> = (0..n)
+            .map(|i| {
+                let o = Vec3::new((i % 100) as f32, (i / 100 % 100) as f32, (i / 10_000) as f32);
+                if large.contains(&i) {
+                    [o, o + Vec3::splat(50.0), o + Vec3::new(50.0, 49.0, 50.0)]
+                } else {
+                    [o, o + Vec3::new(0.1, 0.0, 0.0), o + Vec3::new(0.0, 0.1, 0.0)]
+                }
+            })
+            .collect();
+        let (input, boxes) = described(&tris);
+        let f = presplit_cuts(&input, |i| tris[i as usize], 0.1).expect("the large triangles are cut");
+        assert!(f.owner.is_sorted(), "fragments in triangle order");
+        for i in 0..n {
+            let (from, to) =
+                (f.owner.partition_point(|&o| (o as usize) < i), f.owner.partition_point(|&o| o as usize <= i));
+            let pieces = &f.boxes[from..to];
+            if large.contains(&i) {
+                assert!(pieces.len() > 1, "triangle {i}: {} pieces", pieces.len());
+                assert_eq!(pieces.iter().fold(Aabb::EMPTY, |u, p| u.union(p)), boxes[i]);
+            } else {
+                assert_eq!(pieces, &boxes[i..=i], "triangle {i}");
+            }
+        }
     }
 
     #[test]
