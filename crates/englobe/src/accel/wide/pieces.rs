@@ -120,37 +120,17 @@ mod tests {
 
     use super::*;
     use crate::Aabb;
+    use crate::accel::wide::convert::tests::Refs;
 
-    /// Stores each leaf's primitives as its items.
-    struct Items(Vec<u32>);
-
-    impl LeafSink for Items {
-        type Item = u32;
-        fn max_prims(&self) -> usize {
-            8
-        }
-        fn leaf(&mut self, prims: &[u32]) -> (u32, u8) {
-            let first = self.0.len() as u32;
-            self.0.extend_from_slice(prims);
-            (first, prims.len() as u8)
-        }
-        fn split(&self) -> Self {
-            Items(Vec::new())
-        }
-        fn into_items(self) -> Vec<u32> {
-            self.0
-        }
-        fn append(&mut self, items: &[u32]) -> u32 {
-            let first = self.0.len() as u32;
-            self.0.extend_from_slice(items);
-            first
-        }
+    /// A sink holding `refs`, that stores each leaf's primitives as its items.
+    fn sink(refs: Vec<u32>) -> Refs {
+        Refs { max: 8, refs }
     }
 
     /// A walked piece of two nodes: its root has a leaf of `prims[0]` in slot 0 and node 1 in
     /// slot 1, which has a leaf of `prims[1]` in slot 3.
-    fn walked(prims: [&[u32]; 2], store: &Store<Items>) -> Pieces<Items> {
-        let mut items = Items(Vec::new());
+    fn walked(prims: [&[u32]; 2], store: &Store<Refs>) -> Pieces<Refs> {
+        let mut items = sink(Vec::new());
         let unit = Aabb::new(Vec3::ZERO, Vec3::ONE);
         let mut root = WideNode::EMPTY_NODE;
         let (first, count) = items.leaf(prims[0]);
@@ -164,18 +144,18 @@ mod tests {
 
     /// A root with a leaf of 9, 9 in slot 1 and the walked pieces in slots 0 and 2, assembled
     /// after a sink holding one item already.
-    fn assembled(store: Store<Items>) -> (WideLayout, Vec<u32>) {
+    fn assembled(store: Store<Refs>) -> (WideLayout, Vec<u32>) {
         let unit = Aabb::new(Vec3::ZERO, Vec3::ONE);
-        let mut items = Items(Vec::new());
+        let mut items = sink(Vec::new());
         let mut root = WideNode::EMPTY_NODE;
         let (first, count) = items.leaf(&[9, 9]);
         root.set_child(1, &unit, LEAF | first, count);
         let a = walked([&[1, 2], &[3]], &store);
         let b = walked([&[4], &[5, 6, 7]], &store);
         let pieces = Pieces::joined(root, items, vec![(0, a), (2, b)]);
-        let mut sink = Items(vec![0]);
-        let layout = pieces.assemble(store, &mut sink);
-        (layout, sink.0)
+        let mut after = sink(vec![0]);
+        let layout = pieces.assemble(store, &mut after);
+        (layout, after.refs)
     }
 
     #[test]
