@@ -274,8 +274,8 @@ mod tests {
     use crate::accel::bvh::BinnedSah;
     use crate::accel::wide::binary::BinaryTree;
     use crate::accel::wide::convert::convert;
-    use crate::accel::wide::convert::tests::Refs;
     use crate::accel::wide::node::{EMPTY, WIDTH, index_of, is_leaf};
+    use crate::accel::wide::output::tests::Refs;
 
     /// Boxes of assorted sizes, scattered by a hash (and a few identical ones).
     fn scattered(n: usize) -> Vec<Aabb> {

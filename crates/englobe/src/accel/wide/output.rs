@@ -37,3 +37,37 @@ pub struct WideLayout {
     /// Wide nodes on the longest path from the root to a leaf.
     pub depth: u32,
 }
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::LeafSink;
+
+    /// Stores primitive references, at most `max` per leaf.
+    pub(crate) struct Refs {
+        pub(crate) max: usize,
+        pub(crate) refs: Vec<u32>,
+    }
+
+    impl LeafSink for Refs {
+        fn max_prims(&self) -> usize {
+            self.max
+        }
+        fn leaf(&mut self, prims: &[u32]) -> (u32, u8) {
+            let first = self.refs.len() as u32;
+            self.refs.extend_from_slice(prims);
+            (first, prims.len() as u8)
+        }
+        type Item = u32;
+        fn split(&self) -> Self {
+            Refs { max: self.max, refs: Vec::new() }
+        }
+        fn into_items(self) -> Vec<u32> {
+            self.refs
+        }
+        fn append(&mut self, items: &[u32]) -> u32 {
+            let first = self.refs.len() as u32;
+            self.refs.extend_from_slice(items);
+            first
+        }
+    }
+}

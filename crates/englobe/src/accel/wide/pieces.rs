@@ -120,7 +120,7 @@ mod tests {
 
     use super::*;
     use crate::Aabb;
-    use crate::accel::wide::convert::tests::Refs;
+    use crate::accel::wide::output::tests::Refs;
 
     /// A sink holding `refs`, that stores each leaf's primitives as its items.
     fn sink(refs: Vec<u32>) -> Refs {
