@@ -208,7 +208,8 @@ impl<S: Splitter> Builder<'_, S> {
     }
 
     /// [`Builder::build`]'s subtree as pieces, each with leaf items of its own (made by
-    /// `template`'s [`LeafSink::split`]) and nodes kept in `store`, stored together at the end.
+    /// `template`'s [`LeafSink::split`]), their nodes and items kept in `store` until they are
+    /// stored together at the end.
     #[allow(clippy::too_many_arguments)]
     fn pieces<K: LeafSink + Send + Sync>(
         &self,

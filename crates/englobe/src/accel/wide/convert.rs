@@ -226,7 +226,8 @@ impl<'a, T: BinaryTree> Walker<'a, T> {
     }
 
     /// [`Walker::convert`]'s subtree as pieces, each with leaf items of its own (made by
-    /// `template`'s [`LeafSink::split`]) and nodes kept in `store`, stored together at the end.
+    /// `template`'s [`LeafSink::split`]), their nodes and items kept in `store` until they are
+    /// stored together at the end.
     fn pieces<S: LeafSink + Send + Sync>(&self, part: Part, template: &S, store: &Store<S>, levels: u32) -> Pieces<S>
     where
         T: Sync,

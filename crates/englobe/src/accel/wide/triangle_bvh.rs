@@ -9,7 +9,7 @@
 
 use glam::Vec3;
 
-use super::build::build_wide_with;
+use super::build::{build_wide, build_wide_with};
 use super::convert::{ConvertOptions, LeafSink};
 use super::dispatch;
 use super::isa::{Isa, IsaUnavailable};
@@ -232,15 +232,16 @@ impl TriangleBvh {
         };
         let owners = mapped.as_deref().or(fragments.as_ref().map(|f| &f.owner[..])).or(ids.as_deref());
         let mut sink = Blocks { ids: owners, blocks: Vec::new(), leaf_ids: Vec::new() };
-        let count_built = fragments.as_ref().map_or(stored, |f| f.boxes.len());
-        // Wide nodes straight from the boxes: no binary tree in between.
-        let box_of = |i: usize| match &fragments {
-            Some(f) => f.boxes[i],
-            None => kept[i].bounds,
-        };
+        // Wide nodes straight from the boxes: no binary tree in between. The triangles' own
+        // boxes are kept for the build only if it reads them.
         let options_wide = ConvertOptions { collapse: options.collapse };
-        let (layout, bounds) = build_wide_with(&options.builder, count_built, box_of, options_wide, &mut sink);
-        drop(kept);
+        let (layout, bounds) = match &fragments {
+            Some(f) => {
+                drop(kept);
+                build_wide(&options.builder, &f.boxes, options_wide, &mut sink)
+            }
+            None => build_wide_with(&options.builder, stored, |i| kept[i].bounds, options_wide, &mut sink),
+        };
         let blocks = sink.fill(&triangle);
         TriangleBvh {
             nodes: layout.nodes,
