@@ -177,7 +177,9 @@ impl World {
         });
         let bounded = &bounded[..len];
         let mut leaves = TopPacket::new(self, top, bounded);
-        dispatch::closest_packet(top.isa(), top.nodes(), &PacketRays::new(bounded), among, &mut leaves, counters);
+        let mut packet = PacketRays::new(bounded);
+        packet.bound(bounded);
+        dispatch::closest_packet(top.isa(), top.nodes(), &packet, among, &mut leaves, counters);
         for (i, o) in out.iter_mut().enumerate() {
             let record = &leaves.records[i];
             *o = record
@@ -197,6 +199,8 @@ impl World {
         counters: &mut C,
     ) -> u32 {
         let mut leaves = TopPacket::new(self, top, rays);
-        dispatch::any_packet(top.isa(), top.nodes(), &PacketRays::new(rays), among, &mut leaves, counters)
+        let mut packet = PacketRays::new(rays);
+        packet.bound(rays);
+        dispatch::any_packet(top.isa(), top.nodes(), &packet, among, &mut leaves, counters)
     }
 }

@@ -46,6 +46,7 @@ pub mod kernels;
 pub mod node;
 pub mod output;
 pub mod packet;
+pub mod packet_interval;
 pub mod packet_kernels;
 pub mod packet_triangles;
 mod pieces;

@@ -18,6 +18,7 @@
 use glam::Vec4;
 
 use super::node::{EMPTY, WIDTH, WideNode};
+use super::packet_interval::PacketInterval;
 use crate::geom::aabb::ROBUST_FAR_SCALE;
 use crate::{Aabb, Ray};
 
@@ -44,6 +45,9 @@ pub struct PacketRays {
     pub t_min: Lanes,
     /// Bit `i` of `down[a]` is set if ray `i` goes down axis `a` (its near plane is the upper).
     pub down: [u32; 3],
+    /// The bounds of the rays for culling a node's children all at once, when they allow it
+    /// (see [`PacketInterval`]); `None` from [`PacketRays::new`], set by [`PacketRays::bound`].
+    pub interval: Option<PacketInterval>,
 }
 
 impl PacketRays {
@@ -53,7 +57,14 @@ impl PacketRays {
     pub fn new(rays: &[Ray]) -> Self {
         debug_assert!(rays.len() <= PACKET);
         let zero = Lanes([0.0; PACKET]);
-        let mut p = PacketRays { origin: [zero; 3], inv_dir: [zero; 3], inv_far: [zero; 3], t_min: zero, down: [0; 3] };
+        let mut p = PacketRays {
+            origin: [zero; 3],
+            inv_dir: [zero; 3],
+            inv_far: [zero; 3],
+            t_min: zero,
+            down: [0; 3],
+            interval: None,
+        };
         // What `NodeRay::new` computes, ray by ray, then lane by lane where a vector loop can.
         for (i, ray) in rays.iter().enumerate().take(PACKET) {
             let (o, inv) = (ray.origin(), ray.inv_dir());
@@ -71,6 +82,13 @@ impl PacketRays {
             }
         }
         p
+    }
+
+    /// Adds the interval of `rays` (the ones this packet was made from), so that the SIMD kernels
+    /// skip the children no ray can enter: worth it once the packet has entered the tree's box.
+    #[inline(always)]
+    pub fn bound(&mut self, rays: &[Ray]) {
+        self.interval = PacketInterval::new(rays);
     }
 
     /// The lanes that may enter `bounds` within `t_min..=limits[i]`: [`super::node::may_enter`]
@@ -215,6 +233,20 @@ mod x86 {
 
     use super::{ChildHits, EMPTY, Lanes, PACKET, PacketKernel, PacketRays, WIDTH, WideNode};
 
+    /// The children worth a ray test: those the packet's interval does not cull, or every used
+    /// slot if it has none.
+    ///
+    /// # Safety
+    /// The caller is compiled with AVX and runs on a processor that has it.
+    #[inline(always)]
+    unsafe fn candidates(node: &WideNode, rays: &PacketRays) -> u32 {
+        match &rays.interval {
+            // SAFETY: the caller's guarantee.
+            Some(interval) => unsafe { interval.candidates_avx(node) },
+            None => (0..WIDTH).filter(|&c| node.children[c] != EMPTY).fold(0, |m, c| m | 1 << c),
+        }
+    }
+
     /// Sixteen lanes with AVX-512: the whole packet in one register, the direction signs in mask
     /// registers.
     #[derive(Clone, Copy, Debug)]
@@ -245,10 +277,10 @@ mod x86 {
                 let same_way = rays.down.iter().all(|&d| d & active == 0 || d & active == active);
                 let rows = rays.down.map(|d| (d & active != 0) as usize);
                 let mut mask = 0;
-                for c in 0..WIDTH {
-                    if node.children[c] == EMPTY {
-                        continue;
-                    }
+                let mut candidates = candidates(node, rays);
+                while candidates != 0 {
+                    let c = candidates.trailing_zeros() as usize;
+                    candidates &= candidates - 1;
                     let (mut enter, mut exit) = (t_min, lim);
                     for a in 0..3 {
                         let (t_near, t_far) = if same_way {
@@ -316,6 +348,7 @@ mod x86 {
                 let nan = _mm256_set1_ps(f32::NAN);
                 let mut entered = [0u32; WIDTH];
                 let mut near = [_mm256_set1_ps(f32::INFINITY); WIDTH];
+                let candidates = candidates(node, rays);
                 for h in 0..2 {
                     // Both halves run even when one has no active ray, so that every lane of an
                     // entered child's distances is written.
@@ -327,10 +360,10 @@ mod x86 {
                     // All ones in the lanes going down (`inv < 0`, as `PacketRays::down` says).
                     let down = inv.map(|v| _mm256_cmp_ps::<_CMP_LT_OQ>(v, zero));
                     let (t_min, lim) = (load(&rays.t_min), load(limit));
-                    for c in 0..WIDTH {
-                        if node.children[c] == EMPTY {
-                            continue;
-                        }
+                    let mut left = candidates;
+                    while left != 0 {
+                        let c = left.trailing_zeros() as usize;
+                        left &= left - 1;
                         let (mut enter, mut exit) = (t_min, lim);
                         for a in 0..3 {
                             let lo = _mm256_sub_ps(_mm256_set1_ps(node.bounds[2 * a][c]), o[a]);

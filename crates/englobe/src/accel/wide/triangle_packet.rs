@@ -324,12 +324,13 @@ impl TriangleBvh {
             }
             return;
         }
-        let packet = PacketRays::new(rays);
+        let mut packet = PacketRays::new(rays);
         let limits = limits_of(rays);
         let active = among & packet.may_enter(&self.bounds(), &limits);
         if active == 0 {
             return;
         }
+        packet.bound(rays);
         let mut leaves = TrianglePacket::new(self, rays, &packet, limits, active);
         dispatch::closest_packet(self.isa(), self.nodes(), &packet, active, &mut leaves, counters);
         for (i, h) in hits.iter_mut().enumerate() {
@@ -357,12 +358,13 @@ impl TriangleBvh {
                 .filter(|&i| among >> i & 1 != 0 && self.any_hit_of_valid(&rays[i], counters, NoFilter))
                 .fold(0, |m, i| m | 1 << i);
         }
-        let packet = PacketRays::new(rays);
+        let mut packet = PacketRays::new(rays);
         let limits = limits_of(rays);
         let active = among & packet.may_enter(&self.bounds(), &limits);
         if active == 0 {
             return 0;
         }
+        packet.bound(rays);
         let mut leaves = TrianglePacket::new(self, rays, &packet, limits, active);
         dispatch::any_packet(self.isa(), self.nodes(), &packet, active, &mut leaves, counters)
     }
