@@ -57,6 +57,18 @@ impl Ray {
         self.inv_dir.into()
     }
 
+    /// The origin as an aligned vector, for code that reads the four lanes at once.
+    #[inline(always)]
+    pub(crate) fn origin_a(&self) -> Vec3A {
+        self.origin
+    }
+
+    /// [`Ray::inv_dir`] as an aligned vector.
+    #[inline(always)]
+    pub(crate) fn inv_dir_a(&self) -> Vec3A {
+        self.inv_dir
+    }
+
     /// The point at parameter `t`.
     #[inline(always)]
     pub fn at(&self, t: f32) -> Vec3 {

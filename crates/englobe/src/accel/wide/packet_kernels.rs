@@ -65,21 +65,27 @@ impl PacketRays {
             down: [0; 3],
             interval: None,
         };
-        // What `NodeRay::new` computes, ray by ray, then lane by lane where a vector loop can.
-        for (i, ray) in rays.iter().enumerate().take(PACKET) {
-            let (o, inv) = (ray.origin(), ray.inv_dir());
-            for a in 0..3 {
-                p.origin[a].0[i] = o[a];
-                p.inv_dir[a].0[i] = inv[a];
-            }
-            p.t_min.0[i] = ray.t_min;
-        }
-        for a in 0..3 {
-            for k in 0..PACKET / 4 {
-                let inv = Vec4::from_slice(&p.inv_dir[a].0[4 * k..4 * k + 4]);
-                (inv * ROBUST_FAR_SCALE).write_to_slice(&mut p.inv_far[a].0[4 * k..4 * k + 4]);
+        // What `NodeRay::new` computes, four rays at a time: their vectors transposed into rows
+        // of four lanes by shuffles, each row stored whole. (Storing each ray's coordinates one
+        // by one and reading them back as rows made every read wait for the stores before it.)
+        for (k, four) in rays.chunks(4).enumerate().take(PACKET / 4) {
+            let ray = |j: usize| four.get(j);
+            let rows = |v: fn(&Ray) -> glam::Vec3A| {
+                let col = |j: usize| ray(j).map_or(Vec4::ZERO, |r| v(r).extend(0.0));
+                glam::Mat4::from_cols(col(0), col(1), col(2), col(3)).transpose()
+            };
+            let (o, inv) = (rows(Ray::origin_a), rows(Ray::inv_dir_a));
+            let lanes = 4 * k..4 * k + 4;
+            for (a, (o, inv)) in
+                [(o.x_axis, inv.x_axis), (o.y_axis, inv.y_axis), (o.z_axis, inv.z_axis)].into_iter().enumerate()
+            {
+                o.write_to_slice(&mut p.origin[a].0[lanes.clone()]);
+                inv.write_to_slice(&mut p.inv_dir[a].0[lanes.clone()]);
+                (inv * ROBUST_FAR_SCALE).write_to_slice(&mut p.inv_far[a].0[lanes.clone()]);
                 p.down[a] |= inv.cmplt(Vec4::ZERO).bitmask() << (4 * k);
             }
+            let t_min = |j: usize| ray(j).map_or(0.0, |r| r.t_min);
+            Vec4::new(t_min(0), t_min(1), t_min(2), t_min(3)).write_to_slice(&mut p.t_min.0[lanes]);
         }
         p
     }
