@@ -109,7 +109,7 @@ impl PacketInterval {
     /// The caller is compiled with AVX and runs on a processor that has it.
     #[cfg(target_arch = "x86_64")]
     #[inline(always)]
-    pub unsafe fn candidates_avx(&self, node: &WideNode) -> u32 {
+    pub unsafe fn candidates_avx(&self, node: &WideNode, enter_at: &mut [f32; WIDTH]) -> u32 {
         use std::arch::x86_64::*;
         const { assert!(ROWS == 6 && WIDTH == 8) };
         // SAFETY: AVX is the caller's guarantee; `near_row` is below `ROWS` (made so by `new`),
@@ -133,6 +133,7 @@ impl PacketInterval {
                 enter = _mm256_max_ps(lower, enter);
                 exit = _mm256_min_ps(upper, exit);
             }
+            _mm256_storeu_ps(enter_at.as_mut_ptr(), enter);
             _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(enter, exit)) as u32
         }
     }
@@ -187,7 +188,7 @@ mod tests {
             #[cfg(target_arch = "x86_64")]
             if std::arch::is_x86_feature_detected!("avx") {
                 // SAFETY: the processor has AVX (the function is not inlined into this one).
-                assert_eq!(unsafe { interval.candidates_avx(&node) }, candidates);
+                assert_eq!(unsafe { interval.candidates_avx(&node, &mut [0.0; WIDTH]) }, candidates);
             }
             for slot in 0..WIDTH {
                 let any_enters =

@@ -134,7 +134,9 @@ pub struct ChildHits {
     pub dist: [Lanes; WIDTH],
     /// The rays entering each child (bit per ray).
     pub rays: [u32; WIDTH],
-    /// The least entry distance into each child, over its rays: the order of the walk.
+    /// The order of the walk: the least entry distance into each child over its rays, or, in
+    /// the SIMD kernels of a packet with an interval ([`PacketRays::bound`]), the interval's lower
+    /// bound of every ray's entry distance (no greater, and made without a reduction per child).
     pub near: [f32; WIDTH],
 }
 
@@ -239,17 +241,17 @@ mod x86 {
 
     use super::{ChildHits, EMPTY, Lanes, PACKET, PacketKernel, PacketRays, WIDTH, WideNode};
 
-    /// The children worth a ray test: those the packet's interval does not cull, or every used
-    /// slot if it has none.
+    /// The children worth a ray test: those the packet's interval does not cull, with the
+    /// interval's entry distances in `near` (then `true`), or every used slot if it has none.
     ///
     /// # Safety
     /// The caller is compiled with AVX and runs on a processor that has it.
     #[inline(always)]
-    unsafe fn candidates(node: &WideNode, rays: &PacketRays) -> u32 {
+    unsafe fn candidates(node: &WideNode, rays: &PacketRays, near: &mut [f32; WIDTH]) -> (u32, bool) {
         match &rays.interval {
             // SAFETY: the caller's guarantee.
-            Some(interval) => unsafe { interval.candidates_avx(node) },
-            None => (0..WIDTH).filter(|&c| node.children[c] != EMPTY).fold(0, |m, c| m | 1 << c),
+            Some(interval) => (unsafe { interval.candidates_avx(node, near) }, true),
+            None => ((0..WIDTH).filter(|&c| node.children[c] != EMPTY).fold(0, |m, c| m | 1 << c), false),
         }
     }
 
@@ -283,7 +285,7 @@ mod x86 {
                 let same_way = rays.down.iter().all(|&d| d & active == 0 || d & active == active);
                 let rows = rays.down.map(|d| (d & active != 0) as usize);
                 let mut mask = 0;
-                let mut candidates = candidates(node, rays);
+                let (mut candidates, ordered) = candidates(node, rays, &mut out.near);
                 while candidates != 0 {
                     let c = candidates.trailing_zeros() as usize;
                     candidates &= candidates - 1;
@@ -314,7 +316,9 @@ mod x86 {
                         mask |= 1 << c;
                         _mm512_store_ps(out.dist[c].0.as_mut_ptr(), _mm512_mask_blend_ps(entered, nan, enter));
                         out.rays[c] = entered as u32;
-                        out.near[c] = _mm512_mask_reduce_min_ps(entered, enter);
+                        if !ordered {
+                            out.near[c] = _mm512_mask_reduce_min_ps(entered, enter);
+                        }
                     }
                 }
                 mask
@@ -354,7 +358,7 @@ mod x86 {
                 let nan = _mm256_set1_ps(f32::NAN);
                 let mut entered = [0u32; WIDTH];
                 let mut near = [_mm256_set1_ps(f32::INFINITY); WIDTH];
-                let candidates = candidates(node, rays);
+                let (candidates, ordered) = candidates(node, rays, &mut out.near);
                 for h in 0..2 {
                     // Both halves run even when one has no active ray, so that every lane of an
                     // entered child's distances is written.
@@ -403,6 +407,9 @@ mod x86 {
                     if entered[c] != 0 {
                         mask |= 1 << c;
                         out.rays[c] = entered[c];
+                        if ordered {
+                            continue;
+                        }
                         let mut n = [0.0f32; HALF];
                         _mm256_storeu_ps(n.as_mut_ptr(), near[c]);
                         out.near[c] = n.iter().fold(f32::INFINITY, |a, &b| a.min(b));
@@ -483,8 +490,11 @@ mod tests {
 
     /// The kernel of `isa` on the packet, its lanes compared with the scalar packet kernel's, and
     /// those with the single-ray scalar test, bit for bit.
-    fn check(isa: Isa, node: &WideNode, rays: &[Ray], active: u32) -> u32 {
-        let packet = PacketRays::new(rays);
+    fn check(isa: Isa, node: &WideNode, rays: &[Ray], active: u32, bounded: bool) -> u32 {
+        let mut packet = PacketRays::new(rays);
+        if bounded {
+            packet.bound(rays);
+        }
         let limit = Lanes(std::array::from_fn(|i| rays.get(i).map_or(0.0, |r| reach(r.t_max))));
         let mut got = ChildHits::NONE;
         // SAFETY: each kernel runs only if the processor has its instruction set.
@@ -535,7 +545,11 @@ mod tests {
             assert_eq!(mask >> slot & 1 != 0, rays_in != 0, "{isa}: slot {slot}");
             if rays_in != 0 {
                 assert_eq!(got.rays[slot], rays_in, "{isa}: rays of slot {slot}");
-                assert_eq!(got.near[slot], near, "{isa}: nearest entry of slot {slot}");
+                if packet.interval.is_some() && isa != Isa::Portable {
+                    assert!(got.near[slot] <= near, "{isa}: bound of the nearest entry of slot {slot}");
+                } else {
+                    assert_eq!(got.near[slot], near, "{isa}: nearest entry of slot {slot}");
+                }
             }
             entered += rays_in.count_ones();
         }
@@ -546,7 +560,8 @@ mod tests {
     fn every_packet_kernel_agrees_bit_for_bit_with_the_single_ray_test() {
         // As the single-ray kernels' test: integer planes, axis-parallel directions of both
         // signs and zeros of both signs, so that origins on planes and flat boxes occur; each
-        // packet mixes directions, and some rays are left out of the active mask.
+        // packet mixes directions, and some rays are left out of the active mask. Every other
+        // packet goes one way along each axis, with no zero component, and gets an interval.
         let mut rng = Pcg32::seed_from_u64(0x0009_ace7);
         let next = &mut move |n: u32| rng.random_range(0..n);
         fn point(next: &mut impl FnMut(u32) -> u32, v: &[f32]) -> Vec3 {
@@ -556,8 +571,8 @@ mod tests {
         let values = [-2.0f32, -1.0, -0.0, 0.0, 0.5, 1.0, 2.0];
         let dirs = [-1.0f32, -0.0, 0.0, 0.3, 1.0];
         for isa in Isa::available() {
-            let mut entered = 0;
-            for _ in 0..3_000 {
+            let (mut entered, mut bounded) = (0, 0);
+            for round in 0..6_000 {
                 let mut node = WideNode::EMPTY_NODE;
                 let children = 1 + next(WIDTH as u32) as usize;
                 for slot in 0..children {
@@ -565,17 +580,20 @@ mod tests {
                     node.set_child(slot, &Aabb::new(a.min(b), a.max(b)), slot as u32, 0);
                 }
                 let n = 1 + next(PACKET as u32) as usize;
+                let one_way = round % 2 == 1;
+                let signs = point(next, &[-1.0, 1.0]);
                 let mut rays = Vec::new();
                 for _ in 0..n {
                     let o = point(next, &values) * 1.5;
-                    let d = point(next, &dirs);
+                    let d = if one_way { point(next, &[0.3, 0.5, 1.0]) * signs } else { point(next, &dirs) };
                     let d = if d == Vec3::ZERO { Vec3::X } else { d };
                     rays.push(Ray::segment(o, d, 0.0, [f32::INFINITY, 1.0, 2.5][next(3) as usize]));
                 }
                 let active = (next(1 << 16) | next(1 << 16)) & ((1u32 << n) - 1);
-                entered += check(isa, &node, &rays, active);
+                entered += check(isa, &node, &rays, active, one_way);
+                bounded += (one_way && PacketInterval::new(&rays).is_some()) as u32;
             }
-            assert!(entered > 3_000, "{isa}: {entered}");
+            assert!(entered > 6_000 && bounded == 3_000, "{isa}: {entered} entered, {bounded} bounded");
         }
     }
 }
