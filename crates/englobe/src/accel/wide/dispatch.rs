@@ -181,8 +181,8 @@ mod x86 {
     use super::*;
 
     /// # Safety
-    /// The processor has AVX2 and FMA.
-    #[target_feature(enable = "avx2,fma")]
+    /// The processor has AVX2, FMA and the bit instructions that come with them (see `Isa`).
+    #[target_feature(enable = "avx2,fma,bmi1,bmi2,lzcnt,popcnt")]
     pub unsafe fn closest_avx2<C: Counters, L: Leaves<C>>(
         nodes: &[WideNode],
         depth: u32,
@@ -197,7 +197,7 @@ mod x86 {
 
     /// # Safety
     /// The processor has AVX-512 F, VL, BW and DQ (and AVX2).
-    #[target_feature(enable = "avx2,fma,avx512f,avx512vl,avx512bw,avx512dq")]
+    #[target_feature(enable = "avx2,fma,bmi1,bmi2,lzcnt,popcnt,avx512f,avx512vl,avx512bw,avx512dq")]
     pub unsafe fn closest_avx512<C: Counters, L: Leaves<C>>(
         nodes: &[WideNode],
         depth: u32,
@@ -211,8 +211,8 @@ mod x86 {
     }
 
     /// # Safety
-    /// The processor has AVX2 and FMA.
-    #[target_feature(enable = "avx2,fma")]
+    /// The processor has AVX2, FMA and the bit instructions that come with them (see `Isa`).
+    #[target_feature(enable = "avx2,fma,bmi1,bmi2,lzcnt,popcnt")]
     pub unsafe fn any_avx2<C: Counters, L: Leaves<C>>(
         nodes: &[WideNode],
         depth: u32,
@@ -228,7 +228,7 @@ mod x86 {
 
     /// # Safety
     /// The processor has AVX-512 F, VL, BW and DQ (and AVX2).
-    #[target_feature(enable = "avx2,fma,avx512f,avx512vl,avx512bw,avx512dq")]
+    #[target_feature(enable = "avx2,fma,bmi1,bmi2,lzcnt,popcnt,avx512f,avx512vl,avx512bw,avx512dq")]
     pub unsafe fn any_avx512<C: Counters, L: Leaves<C>>(
         nodes: &[WideNode],
         depth: u32,
@@ -243,8 +243,8 @@ mod x86 {
     }
 
     /// # Safety
-    /// The processor has AVX2 and FMA.
-    #[target_feature(enable = "avx2,fma")]
+    /// The processor has AVX2, FMA and the bit instructions that come with them (see `Isa`).
+    #[target_feature(enable = "avx2,fma,bmi1,bmi2,lzcnt,popcnt")]
     pub unsafe fn closest_packet_avx2<C: Counters, L: PacketLeaves<C>>(
         nodes: &[WideNode],
         rays: &PacketRays,
@@ -258,7 +258,7 @@ mod x86 {
 
     /// # Safety
     /// The processor has AVX-512 F, VL, BW and DQ (and AVX2).
-    #[target_feature(enable = "avx2,fma,avx512f,avx512vl,avx512bw,avx512dq")]
+    #[target_feature(enable = "avx2,fma,bmi1,bmi2,lzcnt,popcnt,avx512f,avx512vl,avx512bw,avx512dq")]
     pub unsafe fn closest_packet_avx512<C: Counters, L: PacketLeaves<C>>(
         nodes: &[WideNode],
         rays: &PacketRays,
@@ -271,8 +271,8 @@ mod x86 {
     }
 
     /// # Safety
-    /// The processor has AVX2 and FMA.
-    #[target_feature(enable = "avx2,fma")]
+    /// The processor has AVX2, FMA and the bit instructions that come with them (see `Isa`).
+    #[target_feature(enable = "avx2,fma,bmi1,bmi2,lzcnt,popcnt")]
     pub unsafe fn any_packet_avx2<C: Counters, L: PacketLeaves<C>>(
         nodes: &[WideNode],
         rays: &PacketRays,
@@ -286,7 +286,7 @@ mod x86 {
 
     /// # Safety
     /// The processor has AVX-512 F, VL, BW and DQ (and AVX2).
-    #[target_feature(enable = "avx2,fma,avx512f,avx512vl,avx512bw,avx512dq")]
+    #[target_feature(enable = "avx2,fma,bmi1,bmi2,lzcnt,popcnt,avx512f,avx512vl,avx512bw,avx512dq")]
     pub unsafe fn any_packet_avx512<C: Counters, L: PacketLeaves<C>>(
         nodes: &[WideNode],
         rays: &PacketRays,

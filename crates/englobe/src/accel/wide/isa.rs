@@ -3,7 +3,8 @@
 //!
 //! * [`Isa::Portable`]: four lanes through glam's `Vec4`, which is SSE2 on x86-64, NEON on
 //!   aarch64 and plain scalar code elsewhere. Always available.
-//! * [`Isa::Avx2`]: eight lanes (x86-64 with AVX2 and FMA).
+//! * [`Isa::Avx2`]: eight lanes (x86-64 with AVX2 and FMA, and BMI1, BMI2, LZCNT and POPCNT,
+//!   which every such processor has: x86-64-v3).
 //! * [`Isa::Avx512`]: eight lanes with AVX-512's mask registers and compress instructions
 //!   (x86-64 with AVX-512 F, VL, BW and DQ).
 //!
@@ -20,7 +21,7 @@ use std::sync::OnceLock;
 pub enum Isa {
     /// Four lanes via glam (SSE2, NEON or scalar): runs everywhere.
     Portable,
-    /// AVX2 and FMA (x86-64).
+    /// AVX2 and FMA, with BMI1, BMI2, LZCNT and POPCNT (x86-64-v3).
     Avx2,
     /// AVX-512 F, VL, BW and DQ (x86-64).
     Avx512,
@@ -90,7 +91,14 @@ pub struct IsaUnavailable(pub Isa);
 
 #[cfg(target_arch = "x86_64")]
 fn detect_avx2() -> bool {
-    is_x86_feature_detected!("avx2") && is_x86_feature_detected!("fma")
+    // The bit instructions (popcount, trailing zeros, BMI2's shifts) that every processor with
+    // AVX2 and FMA has (x86-64-v3): the walks count and pick rays and children by their bits.
+    is_x86_feature_detected!("avx2")
+        && is_x86_feature_detected!("fma")
+        && is_x86_feature_detected!("bmi1")
+        && is_x86_feature_detected!("bmi2")
+        && is_x86_feature_detected!("lzcnt")
+        && is_x86_feature_detected!("popcnt")
 }
 
 #[cfg(target_arch = "x86_64")]

@@ -122,7 +122,7 @@ mod x86 {
     ///
     /// # Safety
     /// The processor has AVX-512 F (and the features enabled here).
-    #[target_feature(enable = "avx2,fma,avx512f,avx512vl,avx512bw,avx512dq")]
+    #[target_feature(enable = "avx2,fma,bmi1,bmi2,lzcnt,popcnt,avx512f,avx512vl,avx512bw,avx512dq")]
     pub unsafe fn block_avx512(
         block: &TriBlock,
         packet: &PacketRays,
