@@ -63,6 +63,12 @@ impl Ray {
         self.origin
     }
 
+    /// [`Ray::dir`] as an aligned vector.
+    #[inline(always)]
+    pub(crate) fn dir_a(&self) -> Vec3A {
+        self.dir
+    }
+
     /// [`Ray::inv_dir`] as an aligned vector.
     #[inline(always)]
     pub(crate) fn inv_dir_a(&self) -> Vec3A {

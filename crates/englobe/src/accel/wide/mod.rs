@@ -22,7 +22,8 @@
 //! * [`isa`]: the instruction sets, detected at run time; [`kernels`]: the slab test of eight
 //!   children for each; `dispatch` (inside the crate): the per-query choice.
 //! * [`traverse`]: the single-ray traversal, generic over kernels and leaves; [`packet`]: the
-//!   traversal of packets of up to sixteen rays, with [`packet_kernels`], their node tests,
+//!   traversal of packets of up to sixteen rays, with [`packet_rays`], the rays as rows of lanes,
+//!   [`packet_kernels`], their node tests,
 //!   [`packet_interval`], the test that culls a node's children for a whole packet at once, and
 //!   [`packet_triangles`], the triangle test of a whole packet.
 //! * [`triangles`]: blocks of four triangles and their SIMD watertight test; [`triangle_bvh`]:
@@ -49,6 +50,7 @@ pub mod output;
 pub mod packet;
 pub mod packet_interval;
 pub mod packet_kernels;
+pub mod packet_rays;
 pub mod packet_triangles;
 mod pieces;
 pub mod point_query;

@@ -89,11 +89,10 @@ pub struct PacketBest {
 }
 
 impl PacketBest {
-    /// No hit yet, each ray's interval ending at its `t_max`.
-    pub fn new(rays: &[Ray]) -> Self {
+    /// No hit yet, each ray's interval ending at its `t_max` (the packet's [`PacketRays::t_max`]).
+    pub fn new(t_max: &Lanes) -> Self {
         let none = Lanes([f32::from_bits(u32::MAX); PACKET]);
-        let t = Lanes(std::array::from_fn(|i| rays.get(i).map_or(0.0, |r| r.t_max)));
-        PacketBest { t, u: Lanes([0.0; PACKET]), v: Lanes([0.0; PACKET]), prim: none }
+        PacketBest { t: *t_max, u: Lanes([0.0; PACKET]), v: Lanes([0.0; PACKET]), prim: none }
     }
 
     /// The triangle ray `i` hits, if any.

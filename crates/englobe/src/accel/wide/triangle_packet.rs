@@ -47,7 +47,7 @@ impl<'a> TrianglePacket<'a> {
     fn new(bvh: &'a TriangleBvh, rays: &'a [Ray], packet: &'a PacketRays, limits: Lanes, active: u32) -> Self {
         // Only AVX-512 has the whole-packet triangle test.
         let decided = !(cfg!(target_arch = "x86_64") && bvh.isa() == Isa::Avx512);
-        TrianglePacket { rays, packet, bvh, simd: None, decided, active, best: PacketBest::new(rays), limits }
+        TrianglePacket { rays, packet, bvh, simd: None, decided, active, best: PacketBest::new(&packet.t_max), limits }
     }
 
     /// The whole-packet triangle constants, if the packet's rays share their axes (see `simd`).
@@ -218,14 +218,6 @@ pub(crate) fn valid_mask(rays: &[Ray]) -> u32 {
     rays.iter().enumerate().fold(0, |m, (i, r)| m | (r.is_valid() as u32) << i)
 }
 
-/// How far each ray of `rays` (1 to [`PACKET`]) may enter a box ([`reach`] of its `t_max`); the
-/// lanes beyond copy the first. A packet drops the rays that pass beside the tree's box first
-/// ([`PacketRays::may_enter`] within these limits, as a single ray does): a packet none of whose
-/// rays enters costs that test and nothing more (no node).
-fn limits_of(rays: &[Ray]) -> Lanes {
-    Lanes(std::array::from_fn(|i| reach(rays.get(i).unwrap_or(&rays[0]).t_max)))
-}
-
 /// Whether `rays` are coherent enough to walk the tree together: directions within about 25
 /// degrees of the first ray's, and origins within a fiftieth of the tree's diagonal of its origin.
 /// Rays that go apart visit the union of their paths, which costs more than walking alone.
@@ -301,11 +293,11 @@ impl TriangleBvh {
 
     /// One packet of 1 to [`PACKET`] rays.
     fn closest_packet_of<C: Counters>(&self, rays: &[Ray], hits: &mut [Option<Hit>], counters: &mut C) {
-        self.closest_packet_among(rays, valid_mask(rays), hits, counters);
+        self.closest_packet_among(rays, u32::MAX, hits, counters);
     }
 
-    /// One packet of 1 to [`PACKET`] rays, of which those of `among` (bit per ray, valid rays
-    /// only: a world checks them once for all its structures) are traced; the others get no hit.
+    /// One packet of 1 to [`PACKET`] rays, of which the valid ones of `among` (bit per ray) are
+    /// traced; the others get no hit.
     pub(crate) fn closest_packet_among<C: Counters>(
         &self,
         rays: &[Ray],
@@ -315,6 +307,9 @@ impl TriangleBvh {
     ) {
         debug_assert!(rays.len() <= PACKET && rays.len() == hits.len());
         hits.fill(None);
+        // The rays' checks come with their transposition, four at a time.
+        let mut packet = PacketRays::new(rays);
+        let among = among & packet.valid;
         if among == 0 || self.nodes().is_empty() {
             return;
         }
@@ -324,8 +319,9 @@ impl TriangleBvh {
             }
             return;
         }
-        let mut packet = PacketRays::new(rays);
-        let limits = limits_of(rays);
+        // The rays that pass beside the tree's box are dropped first, as a single ray is: a
+        // packet none of whose rays enters costs that test and no node.
+        let limits = packet.limits();
         let active = among & packet.may_enter(&self.bounds(), &limits);
         if active == 0 {
             return;
@@ -341,15 +337,17 @@ impl TriangleBvh {
     /// One packet of 1 to [`PACKET`] rays.
     fn any_packet_of<C: Counters>(&self, rays: &[Ray], mask: &mut [bool], counters: &mut C) {
         debug_assert!(rays.len() <= PACKET && rays.len() == mask.len());
-        let hit = self.any_packet_among(rays, valid_mask(rays), counters);
+        let hit = self.any_packet_among(rays, u32::MAX, counters);
         for (i, m) in mask.iter_mut().enumerate() {
             *m = hit >> i & 1 != 0;
         }
     }
 
-    /// The rays of `among` (valid rays of a packet of 1 to [`PACKET`]) that hit something.
+    /// The valid rays of `among` (bits of a packet of 1 to [`PACKET`] rays) that hit something.
     pub(crate) fn any_packet_among<C: Counters>(&self, rays: &[Ray], among: u32, counters: &mut C) -> u32 {
         debug_assert!(rays.len() <= PACKET);
+        let mut packet = PacketRays::new(rays);
+        let among = among & packet.valid;
         if among == 0 || self.nodes().is_empty() {
             return 0;
         }
@@ -358,8 +356,9 @@ impl TriangleBvh {
                 .filter(|&i| among >> i & 1 != 0 && self.any_hit_of_valid(&rays[i], counters, NoFilter))
                 .fold(0, |m, i| m | 1 << i);
         }
-        let mut packet = PacketRays::new(rays);
-        let limits = limits_of(rays);
+        // The rays that pass beside the tree's box are dropped first, as a single ray is: a
+        // packet none of whose rays enters costs that test and no node.
+        let limits = packet.limits();
         let active = among & packet.may_enter(&self.bounds(), &limits);
         if active == 0 {
             return 0;
