@@ -346,7 +346,7 @@ impl TriangleBvh {
         }
         // The root's box first: a ray that passes beside it costs no more.
         counters.box_tests(1);
-        if !may_enter(&self.bounds, ray, reach(ray.t_max)) {
+        if !self.may_enter(ray) {
             return None;
         }
         let mut leaves = TriangleLeaves { blocks: &self.blocks, source: ray, best: None, t_max: ray.t_max, filter };
@@ -374,11 +374,22 @@ impl TriangleBvh {
         }
         // The root's box first: a ray that passes beside it costs no more.
         counters.box_tests(1);
-        if !may_enter(&self.bounds, ray, reach(ray.t_max)) {
+        if !self.may_enter(ray) {
             return false;
         }
         let mut leaves = TriangleLeaves { blocks: &self.blocks, source: ray, best: None, t_max: ray.t_max, filter };
         dispatch::any(self.isa, &self.nodes, self.depth, 0, &NodeRay::new(ray), reach(ray.t_max), &mut leaves, counters)
+    }
+
+    /// Whether `ray` may reach the tree: its origin inside the tree's box (then the root's test
+    /// decides, at no extra cost: the rays of a scene seen from inside, shadow rays and bounces
+    /// start there), or its slab test of the box ([`may_enter`]) passed. Never no where a node
+    /// test would say yes.
+    #[inline(always)]
+    fn may_enter(&self, ray: &Ray) -> bool {
+        let (o, b) = (ray.origin_a(), &self.bounds);
+        (glam::Vec3A::from(b.min).cmple(o) & o.cmple(glam::Vec3A::from(b.max))).all()
+            || may_enter(&self.bounds, ray, reach(ray.t_max))
     }
 
     /// Size and shape: wide nodes, leaves, depth, stored triangles and bytes. The leaf sizes count
