@@ -387,9 +387,7 @@ impl TriangleBvh {
     /// test would say yes.
     #[inline(always)]
     fn may_enter(&self, ray: &Ray) -> bool {
-        let (o, b) = (ray.origin_a(), &self.bounds);
-        (glam::Vec3A::from(b.min).cmple(o) & o.cmple(glam::Vec3A::from(b.max))).all()
-            || may_enter(&self.bounds, ray, reach(ray.t_max))
+        self.bounds.contains_point(ray.origin_a()) || may_enter(&self.bounds, ray, reach(ray.t_max))
     }
 
     /// Size and shape: wide nodes, leaves, depth, stored triangles and bytes. The leaf sizes count
