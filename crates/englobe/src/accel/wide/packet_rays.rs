@@ -99,7 +99,9 @@ impl PacketRays {
     }
 
     /// How far each ray may enter a box ([`super::node::reach`] of its `t_max`), four lanes at a
-    /// time with the same operations (so the same values); 0 in the lanes beyond the rays.
+    /// time with the same operations (so the same values, as a test checks); 0 in the lanes
+    /// beyond the rays. (`reach` mapped over the lanes measured no better, and its code changed
+    /// the inlining around the callers' single-ray loops: 20 more instructions per ray.)
     #[inline(always)]
     pub fn limits(&self) -> Lanes {
         let mut limits = Lanes([0.0; PACKET]);
