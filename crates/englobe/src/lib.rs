@@ -154,8 +154,8 @@ pub mod shapes;
 pub mod world;
 
 pub use accel::{
-    Accel, AccelKind, AnyAccel, ClosestPoint, Counters, Hit, HitFilter, NoCount, NoFilter, TriangleBvh, WideBvh,
-    WorkCounts,
+    Accel, AccelKind, AnyAccel, ClosestPoint, Counters, Hit, HitFilter, NoCount, NoFilter, PacketHits, RayPacket,
+    TriangleBvh, WideBvh, WorkCounts,
 };
 pub use geom::{Aabb, PrimHit, Ray};
 pub use glam::{Affine3A, Mat4, Vec2, Vec3};

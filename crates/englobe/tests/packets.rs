@@ -1,4 +1,5 @@
-//! Packet queries ([`TriangleBvh::closest_hit_packet`], [`TriangleBvh::any_hit_packet`]) and the
+//! Packet queries ([`TriangleBvh::closest_hit_packet`], [`TriangleBvh::any_hit_packet`], and the
+//! same handed over as rows: [`TriangleBvh::closest_hit_ray_packet`]) and the
 //! batches that pick them against the single-ray queries (which the other tests check against
 //! brute force): the same answer for every ray, bit for bit, in every instruction set, for
 //! coherent packets (which take the whole-packet triangle test when their rays share axes) and
@@ -14,7 +15,8 @@ use englobe::accel::wide::Isa;
 use englobe::accel::wide::packet_kernels::PACKET;
 use englobe::accel::wide::triangle_packet::coherent;
 use englobe::{
-    AccelKind, Affine3A, Hit, Instance, NoCount, Object, Plane, Ray, Sphere, TriangleBvh, Vec3, WorkCounts, World,
+    AccelKind, Affine3A, Hit, Instance, NoCount, Object, Plane, Ray, RayPacket, Sphere, TriangleBvh, Vec3, WorkCounts,
+    World,
 };
 use proptest::prelude::*;
 
@@ -32,9 +34,35 @@ fn check(bvh: &mut TriangleBvh, rays: &[Ray]) -> Result<usize, String> {
         bvh.any_hit_packet(rays, &mut any, &mut NoCount).map_err(|e| e.to_string())?;
         bvh.closest_hits(rays, &mut batch).map_err(|e| e.to_string())?;
         bvh.any_hits(rays, &mut batch_any).map_err(|e| e.to_string())?;
+        // The same packets handed over as rows, all lanes traced, then every other lane.
+        let (mut rows, mut rows_any) = (vec![None; rays.len()], vec![false; rays.len()]);
+        for (k, chunk) in rays.chunks(PACKET).enumerate() {
+            let mut packet = RayPacket::default();
+            for (lane, r) in chunk.iter().enumerate() {
+                packet.set(lane, r.origin(), r.dir(), r.t_min, r.t_max);
+            }
+            let all = (1u32 << chunk.len()) - 1;
+            let got = bvh.closest_hit_ray_packet(&packet, all, &mut WorkCounts::default());
+            let got_any = bvh.any_hit_ray_packet(&packet, all, &mut NoCount);
+            let half = all & 0x5555;
+            let (some, some_any) = (
+                bvh.closest_hit_ray_packet(&packet, half, &mut NoCount),
+                bvh.any_hit_ray_packet(&packet, half, &mut NoCount),
+            );
+            for lane in 0..chunk.len() {
+                let i = k * PACKET + lane;
+                (rows[i], rows_any[i]) = (got.hit(lane), got_any >> lane & 1 != 0);
+                let expected = if half >> lane & 1 != 0 { (single[i], single_any[i]) } else { (None, false) };
+                if (some.hit(lane), some_any >> lane & 1 != 0) != expected {
+                    return Err(format!("{isa}, every other lane, ray {i} {:?}: expected {expected:?}", rays[i]));
+                }
+            }
+        }
         for (i, ray) in rays.iter().enumerate() {
             let expected = (single[i], single_any[i]);
-            for (what, got) in [("packet", (hits[i], any[i])), ("batch", (batch[i], batch_any[i]))] {
+            for (what, got) in
+                [("packet", (hits[i], any[i])), ("batch", (batch[i], batch_any[i])), ("rows", (rows[i], rows_any[i]))]
+            {
                 if got != expected {
                     return Err(format!("{isa}, {what}, ray {i} {ray:?}: single rays {expected:?}, {got:?}"));
                 }

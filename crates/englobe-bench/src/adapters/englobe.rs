@@ -12,7 +12,7 @@ use std::fmt;
 
 use englobe::accel::wide::Isa;
 use englobe::accel::wide::packet_kernels::PACKET;
-use englobe::{AccelKind, NoCount, Object, Ray, TriangleBvh, Vec3, World};
+use englobe::{AccelKind, NoCount, Object, PacketHits, RayPacket, TriangleBvh, World};
 
 use crate::library::{BenchRay, Library, RayResult};
 use crate::scene::BenchScene;
@@ -130,12 +130,13 @@ impl EnglobeLibrary {
     }
 }
 
-/// The rays of a packet, converted.
-fn packet_rays(rays: &[BenchRay], out: &mut [Ray; PACKET]) -> usize {
-    for (o, r) in out.iter_mut().zip(rays) {
-        *o = r.to_englobe();
+/// Puts up to [`RayPacket::LANES`] rays into `packet`'s rows, as the Embree adapter fills its
+/// `RTCRay16`; returns the mask of the lanes filled.
+fn fill_packet(rays: &[BenchRay], packet: &mut RayPacket) -> u32 {
+    for (lane, r) in rays.iter().enumerate().take(RayPacket::LANES) {
+        packet.set(lane, r.origin, r.dir, r.t_min, r.t_max);
     }
-    rays.len().min(PACKET)
+    (1u32 << rays.len().min(RayPacket::LANES)) - 1
 }
 
 impl Library for EnglobeLibrary {
@@ -156,13 +157,15 @@ impl Library for EnglobeLibrary {
 
     fn closest_hits(&self, rays: &[BenchRay], out: &mut [RayResult]) {
         if let (true, Built::Triangles(bvh)) = (self.packets, &self.built) {
-            let mut packet = [Ray::new(Vec3::ZERO, Vec3::Z); PACKET];
-            let mut hits = [None; PACKET];
+            let mut packet = RayPacket::default();
             for (rays, out) in rays.chunks(PACKET).zip(out.chunks_mut(PACKET)) {
-                let n = packet_rays(rays, &mut packet);
-                bvh.closest_hit_packet(&packet[..n], &mut hits[..n], &mut NoCount).expect("as many hits as rays");
-                for (o, h) in out.iter_mut().zip(&hits) {
-                    *o = h.map_or(RayResult::MISS, |h| RayResult::hit(h.t, h.prim));
+                let active = fill_packet(rays, &mut packet);
+                let hits = bvh.closest_hit_ray_packet(&packet, active, &mut NoCount);
+                for (lane, o) in out.iter_mut().enumerate() {
+                    *o = match hits.prim[lane] {
+                        PacketHits::MISS => RayResult::MISS,
+                        prim => RayResult::hit(hits.t[lane], prim),
+                    };
                 }
             }
             return;
@@ -185,10 +188,13 @@ impl Library for EnglobeLibrary {
 
     fn any_hits(&self, rays: &[BenchRay], out: &mut [bool]) {
         if let (true, Built::Triangles(bvh)) = (self.packets, &self.built) {
-            let mut packet = [Ray::new(Vec3::ZERO, Vec3::Z); PACKET];
+            let mut packet = RayPacket::default();
             for (rays, out) in rays.chunks(PACKET).zip(out.chunks_mut(PACKET)) {
-                let n = packet_rays(rays, &mut packet);
-                bvh.any_hit_packet(&packet[..n], out, &mut NoCount).expect("as many answers as rays");
+                let active = fill_packet(rays, &mut packet);
+                let hit = bvh.any_hit_ray_packet(&packet, active, &mut NoCount);
+                for (lane, o) in out.iter_mut().enumerate() {
+                    *o = hit >> lane & 1 != 0;
+                }
             }
             return;
         }

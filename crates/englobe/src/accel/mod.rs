@@ -34,4 +34,4 @@ pub use interface::{
 pub use kdtree::{KdTree, KdTreeParams};
 pub use reference::{BruteForce, CandidateListBvh, LowerBound, SeedPairing};
 pub use select::{AccelKind, AnyAccel, UnknownAccel};
-pub use wide::{ClosestPoint, Isa, TriangleBvh, WideBvh};
+pub use wide::{ClosestPoint, Isa, PacketHits, RayPacket, TriangleBvh, WideBvh};

@@ -39,6 +39,14 @@ impl Ray {
         Ray { origin: origin.into(), dir, inv_dir: safe_inverse(dir), t_min, t_max }
     }
 
+    /// A ray from its parts, `inv_dir` being what [`Ray::segment`] computes for `dir` (as a
+    /// packet's rays are taken apart and put back together).
+    #[inline(always)]
+    pub(crate) fn from_parts(origin: Vec3A, dir: Vec3A, inv_dir: Vec3A, t_min: f32, t_max: f32) -> Self {
+        debug_assert!(inv_dir.to_array().map(f32::to_bits) == safe_inverse(dir).to_array().map(f32::to_bits));
+        Ray { origin, dir, inv_dir, t_min, t_max }
+    }
+
     /// The origin.
     #[inline(always)]
     pub fn origin(&self) -> Vec3 {

@@ -178,7 +178,7 @@ impl World {
         let bounded = &bounded[..len];
         let mut leaves = TopPacket::new(self, top, bounded);
         let mut packet = PacketRays::new(bounded);
-        packet.bound(bounded);
+        packet.bound(among);
         dispatch::closest_packet(top.isa(), top.nodes(), &packet, among, &mut leaves, counters);
         for (i, o) in out.iter_mut().enumerate() {
             let record = &leaves.records[i];
@@ -200,7 +200,7 @@ impl World {
     ) -> u32 {
         let mut leaves = TopPacket::new(self, top, rays);
         let mut packet = PacketRays::new(rays);
-        packet.bound(rays);
+        packet.bound(among);
         dispatch::any_packet(top.isa(), top.nodes(), &packet, among, &mut leaves, counters)
     }
 }

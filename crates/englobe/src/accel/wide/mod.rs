@@ -27,7 +27,8 @@
 //!   [`packet_interval`], the test that culls a node's children for a whole packet at once, and
 //!   [`packet_triangles`], the triangle test of a whole packet.
 //! * [`triangles`]: blocks of four triangles and their SIMD watertight test; [`triangle_bvh`]:
-//!   [`TriangleBvh`]; [`triangle_packet`]: its packet queries and batches; [`presplit`]: the
+//!   [`TriangleBvh`]; [`triangle_packet`]: its packet queries and batches, with [`ray_packet`],
+//!   the rays and hits of a packet as rows that programs fill and read; [`presplit`]: the
 //!   large triangles cut before its build.
 //! * [`point_query`]: the closest point of the triangles to a point; [`box_query`]: the
 //!   triangles overlapping a box.
@@ -55,6 +56,7 @@ pub mod packet_triangles;
 mod pieces;
 pub mod point_query;
 pub mod presplit;
+pub mod ray_packet;
 pub mod refit;
 pub mod traverse;
 pub mod triangle_bvh;
@@ -64,6 +66,7 @@ pub mod validate;
 
 pub use isa::{Isa, IsaUnavailable};
 pub use point_query::ClosestPoint;
+pub use ray_packet::{PacketHits, RayPacket};
 pub use refit::{RefitError, RefitReport};
 pub use triangle_bvh::{TriangleBvh, TriangleBvhOptions};
 

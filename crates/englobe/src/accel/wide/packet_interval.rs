@@ -74,16 +74,26 @@ impl PacketInterval {
             // A NaN `t_min` (a ray no query asks for) is passed over by `min`.
             t_min = t_min.min(ray.t_min);
         }
+        Some(Self::from_bounds(down, [o_lo, o_hi], [inv_lo, inv_hi], t_min))
+    }
+
+    /// The interval of rays whose origins lie within `origin` (least and greatest per axis),
+    /// inverse directions within `inv`, going down the axes of `down` (bit per axis).
+    #[inline(always)]
+    pub(super) fn from_bounds(down: u32, origin: [Vec3A; 2], inv: [Vec3A; 2], t_min: f32) -> Self {
+        let ([o_lo, o_hi], [inv_lo, inv_hi]) = (origin, inv);
         let going_down = |a: usize| down >> a & 1 != 0;
         let (inv_far_lo, inv_far_hi) = (inv_lo * ROBUST_FAR_SCALE, inv_hi * ROBUST_FAR_SCALE);
-        Some(PacketInterval {
-            near_row: [0, 1, 2].map(|a| 2 * a + going_down(a) as usize),
-            near_origin: [0, 1, 2].map(|a| if going_down(a) { o_lo[a] } else { o_hi[a] }),
-            far_origin: [0, 1, 2].map(|a| if going_down(a) { o_hi[a] } else { o_lo[a] }),
-            inv: [0, 1, 2].map(|a| [inv_lo[a], inv_hi[a]]),
-            inv_far: [0, 1, 2].map(|a| [inv_far_lo[a], inv_far_hi[a]]),
+        // The arrays spelled out: `[0, 1, 2].map` compiled to calls.
+        let down_or_up = |a: usize, down: Vec3A, up: Vec3A| if going_down(a) { down[a] } else { up[a] };
+        PacketInterval {
+            near_row: [going_down(0) as usize, 2 + going_down(1) as usize, 4 + going_down(2) as usize],
+            near_origin: [down_or_up(0, o_lo, o_hi), down_or_up(1, o_lo, o_hi), down_or_up(2, o_lo, o_hi)],
+            far_origin: [down_or_up(0, o_hi, o_lo), down_or_up(1, o_hi, o_lo), down_or_up(2, o_hi, o_lo)],
+            inv: [[inv_lo.x, inv_hi.x], [inv_lo.y, inv_hi.y], [inv_lo.z, inv_hi.z]],
+            inv_far: [[inv_far_lo.x, inv_far_hi.x], [inv_far_lo.y, inv_far_hi.y], [inv_far_lo.z, inv_far_hi.z]],
             t_min,
-        })
+        }
     }
 
     /// The children of `node` that some ray of the packet may enter (bit per slot), one plane at

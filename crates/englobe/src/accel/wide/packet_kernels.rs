@@ -346,7 +346,7 @@ mod tests {
     fn check(isa: Isa, node: &WideNode, rays: &[Ray], active: u32, bounded: bool) -> u32 {
         let mut packet = PacketRays::new(rays);
         if bounded {
-            packet.bound(rays);
+            packet.bound(active);
         }
         let limit = Lanes(std::array::from_fn(|i| rays.get(i).map_or(0.0, |r| reach(r.t_max))));
         let mut got = ChildHits::NONE;

@@ -5,7 +5,7 @@
 //! Tracing"); the rays' checks and limits, made four rays at a time; and the packet's test
 //! against the tree's box.
 
-use glam::Vec4;
+use glam::{BVec4A, Vec3A, Vec4};
 
 use super::packet_interval::PacketInterval;
 use crate::geom::aabb::ROBUST_FAR_SCALE;
@@ -26,6 +26,8 @@ pub struct Lanes(pub [f32; PACKET]);
 pub struct PacketRays {
     /// Origins, one row per axis.
     pub origin: [Lanes; 3],
+    /// Directions.
+    pub dir: [Lanes; 3],
     /// Inverse directions.
     pub inv_dir: [Lanes; 3],
     /// Inverse directions times the robust far scale (see [`super::node::NodeRay::inv_far`]).
@@ -52,6 +54,7 @@ impl PacketRays {
         let zero = Lanes([0.0; PACKET]);
         let mut p = PacketRays {
             origin: [zero; 3],
+            dir: [zero; 3],
             inv_dir: [zero; 3],
             inv_far: [zero; 3],
             t_min: zero,
@@ -71,10 +74,16 @@ impl PacketRays {
             };
             let (o, d, inv) = (rows(Ray::origin_a), rows(Ray::dir_a), rows(Ray::inv_dir_a));
             let lanes = 4 * k..4 * k + 4;
-            for (a, (o, inv)) in
-                [(o.x_axis, inv.x_axis), (o.y_axis, inv.y_axis), (o.z_axis, inv.z_axis)].into_iter().enumerate()
+            for (a, (o, (d, inv))) in [
+                (o.x_axis, (d.x_axis, inv.x_axis)),
+                (o.y_axis, (d.y_axis, inv.y_axis)),
+                (o.z_axis, (d.z_axis, inv.z_axis)),
+            ]
+            .into_iter()
+            .enumerate()
             {
                 o.write_to_slice(&mut p.origin[a].0[lanes.clone()]);
+                d.write_to_slice(&mut p.dir[a].0[lanes.clone()]);
                 inv.write_to_slice(&mut p.inv_dir[a].0[lanes.clone()]);
                 (inv * ROBUST_FAR_SCALE).write_to_slice(&mut p.inv_far[a].0[lanes.clone()]);
                 p.down[a] |= inv.cmplt(Vec4::ZERO).bitmask() << (4 * k);
@@ -112,11 +121,72 @@ impl PacketRays {
         limits
     }
 
-    /// Adds the interval of `rays` (the ones this packet was made from), so that the SIMD kernels
-    /// skip the children no ray can enter: worth it once the packet has entered the tree's box.
+    /// Adds the interval of the rays in `lanes` (bit per lane: the ones a query traces), so that
+    /// the SIMD kernels skip the children no such ray can enter: worth it once the packet has
+    /// entered the tree's box.
     #[inline(always)]
-    pub fn bound(&mut self, rays: &[Ray]) {
-        self.interval = PacketInterval::new(rays);
+    pub fn bound(&mut self, lanes: u32) {
+        self.interval = self.interval(lanes);
+    }
+
+    /// The interval of the rays in `lanes` (bit per lane), as [`PacketInterval::new`] gives it
+    /// for those rays, read from the rows four lanes at a time; `None` in the same cases, and for
+    /// no lane at all.
+    #[inline(always)]
+    fn interval(&self, lanes: u32) -> Option<PacketInterval> {
+        let packet = self;
+        if lanes == 0 {
+            return None;
+        }
+        // One way along each axis: the lanes' signs all set or all clear.
+        let mut down = 0;
+        for (a, &d) in packet.down.iter().enumerate() {
+            match d & lanes {
+                0 => {}
+                d if d == lanes => down |= 1 << a,
+                _ => return None,
+            }
+        }
+        let (mut o_lo, mut o_hi) = ([Vec4::INFINITY; 3], [Vec4::NEG_INFINITY; 3]);
+        let (mut inv_lo, mut inv_hi) = ([Vec4::INFINITY; 3], [Vec4::NEG_INFINITY; 3]);
+        let mut t_min = Vec4::INFINITY;
+        for k in 0..PACKET / 4 {
+            let m = lanes >> (4 * k) & 0xf;
+            if m == 0 {
+                continue;
+            }
+            let four = |l: &Lanes| Vec4::from_slice(&l.0[4 * k..4 * k + 4]);
+            let taken = BVec4A::new(m & 1 != 0, m & 2 != 0, m & 4 != 0, m & 8 != 0);
+            // The lanes left out take neutral values: infinities the extremes pass over.
+            let (low, high) =
+                (|v| Vec4::select(taken, v, Vec4::INFINITY), |v| Vec4::select(taken, v, Vec4::NEG_INFINITY));
+            for a in 0..3 {
+                let (o, inv) = (four(&packet.origin[a]), four(&packet.inv_dir[a]));
+                let usable = o.is_finite_mask() & inv.is_finite_mask() & inv.cmpne(Vec4::ZERO);
+                if usable.bitmask() & m != m {
+                    return None;
+                }
+                (o_lo[a], o_hi[a]) = (o_lo[a].min(low(o)), o_hi[a].max(high(o)));
+                (inv_lo[a], inv_hi[a]) = (inv_lo[a].min(low(inv)), inv_hi[a].max(high(inv)));
+            }
+            t_min = t_min.min(low(four(&packet.t_min)));
+        }
+        let least = |v: [Vec4; 3]| Vec3A::from_array(v.map(Vec4::min_element));
+        let greatest = |v: [Vec4; 3]| Vec3A::from_array(v.map(Vec4::max_element));
+        Some(PacketInterval::from_bounds(
+            down,
+            [least(o_lo), greatest(o_hi)],
+            [least(inv_lo), greatest(inv_hi)],
+            t_min.min_element(),
+        ))
+    }
+
+    /// Ray `i` of the packet, as it was given: the same origin, direction, inverse direction and
+    /// interval, bit for bit.
+    #[inline(always)]
+    pub fn ray(&self, i: usize) -> Ray {
+        let lane = |rows: &[Lanes; 3]| Vec3A::new(rows[0].0[i], rows[1].0[i], rows[2].0[i]);
+        Ray::from_parts(lane(&self.origin), lane(&self.dir), lane(&self.inv_dir), self.t_min.0[i], self.t_max.0[i])
     }
 
     /// The lanes that may enter `bounds` within `t_min..=limits[i]`: [`super::node::may_enter`]
@@ -226,5 +296,33 @@ mod tests {
             assert_eq!(packet.valid >> rays.len(), 0, "lanes beyond the rays are not valid");
         }
         assert!(valid > 5_000 && invalid > 5_000, "{valid} valid, {invalid} invalid");
+    }
+
+    #[test]
+    fn the_interval_of_some_lanes_is_the_interval_of_their_rays() {
+        let mut rng = Pcg32::seed_from_u64(0x1a7e_b0da);
+        let mut some = 0;
+        for round in 0..3_000 {
+            let signs = Vec3::new(1.0, -1.0, 1.0) * if round % 5 == 0 { -1.0 } else { 1.0 };
+            let rays: Vec<Ray> = (0..1 + round % PACKET)
+                .map(|_| {
+                    let o = Vec3::new(rng.random_range(-3.0..3.0), rng.random_range(-3.0..3.0), 0.0);
+                    // Now and then a ray going the other way along x, or along no axis at all.
+                    let mut d = Vec3::new(rng.random_range(0.1..1.0), rng.random_range(0.1..1.0), 0.5) * signs;
+                    match rng.random_range(0..40) {
+                        0 => d.x = -d.x,
+                        1 => d.y = 0.0,
+                        _ => {}
+                    }
+                    Ray::segment(o, d, rng.random_range(-1.0..1.0), 10.0)
+                })
+                .collect();
+            let lanes = rng.random_range(0..1u32 << rays.len());
+            let chosen: Vec<Ray> = (0..rays.len()).filter(|&i| lanes >> i & 1 != 0).map(|i| rays[i]).collect();
+            let expected = PacketInterval::new(&chosen);
+            assert_eq!(PacketRays::new(&rays).interval(lanes), expected, "lanes {lanes:b} of {rays:?}");
+            some += expected.is_some() as u32;
+        }
+        assert!(some > 1_000, "{some}");
     }
 }

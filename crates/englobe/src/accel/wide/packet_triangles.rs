@@ -11,7 +11,8 @@
 //! So every ray keeps the answer of its own query.
 
 use super::packet_kernels::{Lanes, PACKET, PacketRays};
-use crate::Ray;
+use crate::Vec3;
+use crate::accel::Hit;
 use crate::shapes::WatertightRay;
 
 /// A packet whose rays share the watertight test's axes, prepared for triangle tests: what the
@@ -28,34 +29,33 @@ pub struct PacketTriRays {
 }
 
 impl PacketTriRays {
-    /// Prepares the rays of `active` (bit per ray of `rays`, at least one), or `None` if they do
-    /// not all share the watertight test's axes.
+    /// Prepares the rays of `active` (bit per ray of `packet`, at least one), or `None` if they
+    /// do not all share the watertight test's axes.
     #[inline(always)]
-    pub fn new(rays: &[Ray], active: u32) -> Option<Self> {
+    pub fn new(packet: &PacketRays, active: u32) -> Option<Self> {
         if active == 0 {
             return None;
         }
-        let axes = WatertightRay::axes_of(rays[active.trailing_zeros() as usize].dir());
-        let zero = Lanes([0.0; PACKET]);
-        let mut p = PacketTriRays { origin_k: [zero; 3], shear: [zero; 3], axes };
-        // The directions on the shared axes; 1 along `kz` in the lanes left out, so that the
-        // divisions below stay finite there.
-        let (mut dx, mut dy, mut dz) = ([0.0f32; PACKET], [0.0f32; PACKET], [1.0f32; PACKET]);
-        for (i, ray) in rays.iter().enumerate().take(PACKET) {
-            if active >> i & 1 == 0 {
-                continue;
-            }
-            let d = ray.dir();
+        let dir = |i: usize| Vec3::new(packet.dir[0].0[i], packet.dir[1].0[i], packet.dir[2].0[i]);
+        let axes = WatertightRay::axes_of(dir(active.trailing_zeros() as usize));
+        let mut rest = active;
+        while rest != 0 {
+            let i = rest.trailing_zeros() as usize;
+            rest &= rest - 1;
             // Compared as one small integer: comparing the arrays made the compiler store them
             // and load them back as a vector, a stall per ray.
-            if packed(WatertightRay::axes_of(d)) != packed(axes) {
+            if packed(WatertightRay::axes_of(dir(i))) != packed(axes) {
                 return None;
             }
-            let o = ray.origin();
-            for a in 0..3 {
-                p.origin_k[a].0[i] = o[axes[a]];
+        }
+        // The rows of the shared axes, whole: the lanes left out are never read but for the
+        // divisions below, where 1 along `kz` keeps them finite.
+        let mut p = PacketTriRays { origin_k: axes.map(|a| packet.origin[a]), shear: [Lanes([0.0; PACKET]); 3], axes };
+        let [dx, dy, mut dz] = axes.map(|a| packet.dir[a].0);
+        for (i, dz) in dz.iter_mut().enumerate() {
+            if active >> i & 1 == 0 {
+                *dz = 1.0;
             }
-            (dx[i], dy[i], dz[i]) = (d[axes[0]], d[axes[1]], d[axes[2]]);
         }
         // The shear of `WatertightRay::new`, the same divisions lane by lane (one vector loop).
         for i in 0..PACKET {
@@ -99,6 +99,21 @@ impl PacketBest {
     #[inline(always)]
     pub fn prim(&self, i: usize) -> u32 {
         self.prim.0[i].to_bits()
+    }
+
+    /// The closest hit of ray `i`.
+    #[inline(always)]
+    pub fn hit(&self, i: usize) -> Option<Hit> {
+        (self.prim(i) != u32::MAX).then(|| Hit { t: self.t.0[i], prim: self.prim(i), u: self.u.0[i], v: self.v.0[i] })
+    }
+
+    /// Keeps `hit` as ray `i`'s closest if it is closer, or as close with a lower index (the rule
+    /// of [`crate::accel::HitRecord::offer`]).
+    #[inline(always)]
+    pub fn offer(&mut self, i: usize, hit: Hit) {
+        if hit.t < self.t.0[i] || (hit.t == self.t.0[i] && hit.prim < self.prim(i)) {
+            (self.t.0[i], self.u.0[i], self.v.0[i], self.prim.0[i]) = (hit.t, hit.u, hit.v, f32::from_bits(hit.prim));
+        }
     }
 }
 

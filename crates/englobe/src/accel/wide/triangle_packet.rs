@@ -13,6 +13,7 @@ use super::packet_kernels::{Lanes, PACKET, PacketRays};
 #[cfg(target_arch = "x86_64")]
 use super::packet_triangles;
 use super::packet_triangles::{PacketBest, PacketTriRays};
+use super::ray_packet::{PacketHits, RayPacket};
 use super::traverse::Leaves;
 use super::triangle_bvh::{TriangleBvh, TriangleLeaves};
 use super::triangles::TriRay;
@@ -25,9 +26,8 @@ use crate::{Aabb, Ray};
 /// rays sharing the watertight test's axes, each triangle is tested against the whole packet at
 /// once; otherwise each ray's leaves are tested by the single-ray leaf test.
 struct TrianglePacket<'a> {
-    rays: &'a [Ray],
-    /// The same rays prepared for node tests (their origins, inverse directions and `t_min` are
-    /// read by the whole-packet triangle test too).
+    /// The rays, prepared for node tests (their origins, inverse directions and `t_min` are read
+    /// by the whole-packet triangle test too; the single-ray tests take each ray back out).
     packet: &'a PacketRays,
     bvh: &'a TriangleBvh,
     /// The shared-axes constants, when the packet's triangle tests run on whole packets;
@@ -42,12 +42,12 @@ struct TrianglePacket<'a> {
 }
 
 impl<'a> TrianglePacket<'a> {
-    /// The state of a packet of `rays` (at least one; the lanes beyond them are never asked for),
-    /// of which `active` will be traced, within `limits` (see [`reach`]): no hit yet.
-    fn new(bvh: &'a TriangleBvh, rays: &'a [Ray], packet: &'a PacketRays, limits: Lanes, active: u32) -> Self {
+    /// The state of a packet of which `active` will be traced, within `limits` (see [`reach`]):
+    /// no hit yet.
+    fn new(bvh: &'a TriangleBvh, packet: &'a PacketRays, limits: Lanes, active: u32) -> Self {
         // Only AVX-512 has the whole-packet triangle test.
         let decided = !(cfg!(target_arch = "x86_64") && bvh.isa() == Isa::Avx512);
-        TrianglePacket { rays, packet, bvh, simd: None, decided, active, best: PacketBest::new(&packet.t_max), limits }
+        TrianglePacket { packet, bvh, simd: None, decided, active, best: PacketBest::new(&packet.t_max), limits }
     }
 
     /// The whole-packet triangle constants, if the packet's rays share their axes (see `simd`).
@@ -55,32 +55,26 @@ impl<'a> TrianglePacket<'a> {
     fn simd(&mut self) -> Option<PacketTriRays> {
         if !self.decided {
             self.decided = true;
-            self.simd = PacketTriRays::new(self.rays, self.active);
+            self.simd = PacketTriRays::new(self.packet, self.active);
         }
         self.simd
     }
 
-    /// Ray `i`'s single-ray leaf state, its interval ending at its closest hit so far.
+    /// Ray `i`'s single-ray leaf state (`source` being [`PacketRays::ray`]`(i)`), its interval
+    /// ending at its closest hit so far.
     #[inline(always)]
-    fn lane(&self, i: usize) -> TriangleLeaves<'a, NoFilter> {
-        let source = &self.rays[i.min(self.rays.len() - 1)];
+    fn lane<'r>(&self, source: &'r Ray, i: usize) -> TriangleLeaves<'r, NoFilter>
+    where
+        'a: 'r,
+    {
         let blocks = self.bvh.blocks();
         TriangleLeaves { blocks, source, best: None, t_max: self.best.t.0[i], filter: NoFilter }
-    }
-
-    /// The closest hit of ray `i`.
-    fn hit(&self, i: usize) -> Option<Hit> {
-        let b = &self.best;
-        (b.prim(i) != u32::MAX).then(|| Hit { t: b.t.0[i], prim: b.prim(i), u: b.u.0[i], v: b.v.0[i] })
     }
 
     /// Keeps `hit` as ray `i`'s closest if it is closer, or as close with a lower index.
     #[inline(always)]
     fn offer(&mut self, i: usize, hit: Hit) {
-        let b = &mut self.best;
-        if hit.t < b.t.0[i] || (hit.t == b.t.0[i] && hit.prim < b.prim(i)) {
-            (b.t.0[i], b.u.0[i], b.v.0[i], b.prim.0[i]) = (hit.t, hit.u, hit.v, f32::from_bits(hit.prim));
-        }
+        self.best.offer(i, hit);
     }
 
     /// Tests the blocks from `first` against the rays of `rays` a whole packet at a time; returns
@@ -114,7 +108,7 @@ impl<'a> TrianglePacket<'a> {
                 let (lane, i) = (bit / PACKET, bit % PACKET);
                 if closest || found >> i & 1 == 0 {
                     let t_max = self.best.t.0[i];
-                    if let Some(h) = TriRay::scalar(&self.rays[i], block, lane, t_max) {
+                    if let Some(h) = TriRay::scalar(&self.packet.ray(i), block, lane, t_max) {
                         found |= 1 << i;
                         self.offer(i, Hit { t: h.t, prim: block.ids[lane], u: h.u, v: h.v });
                     }
@@ -146,7 +140,8 @@ impl<C: Counters> PacketLeaves<C> for TrianglePacket<'_> {
         while rays != 0 {
             let i = rays.trailing_zeros() as usize;
             rays &= rays - 1;
-            let mut lane = self.lane(i);
+            let source = self.packet.ray(i);
+            let mut lane = self.lane(&source, i);
             let ray = Leaves::<C>::prepare(&lane);
             Leaves::<C>::closest(&mut lane, &ray, first, count, counters);
             if let Some(hit) = lane.best {
@@ -166,7 +161,8 @@ impl<C: Counters> PacketLeaves<C> for TrianglePacket<'_> {
         while rays != 0 {
             let i = rays.trailing_zeros() as usize;
             rays &= rays - 1;
-            let mut lane = self.lane(i);
+            let source = self.packet.ray(i);
+            let mut lane = self.lane(&source, i);
             let ray = Leaves::<C>::prepare(&lane);
             if Leaves::<C>::any(&mut lane, &ray, first, count, counters) {
                 found |= 1 << i;
@@ -192,9 +188,9 @@ impl<C: Counters> PacketLeaves<C> for TrianglePacket<'_> {
         while rays != 0 {
             let i = rays.trailing_zeros() as usize;
             rays &= rays - 1;
-            let source = &self.rays[i];
+            let source = &self.packet.ray(i);
             let node_ray = NodeRay::new(source);
-            let mut lane = self.lane(i);
+            let mut lane = self.lane(source, i);
             if closest {
                 dispatch::closest(bvh.isa(), bvh.nodes(), bvh.depth(), reference, &node_ray, &mut lane, counters);
                 if let Some(hit) = lane.best {
@@ -306,32 +302,68 @@ impl TriangleBvh {
         counters: &mut C,
     ) {
         debug_assert!(rays.len() <= PACKET && rays.len() == hits.len());
-        hits.fill(None);
         // The rays' checks come with their transposition, four at a time.
-        let mut packet = PacketRays::new(rays);
+        let best = self.closest_of_packet(&mut PacketRays::new(rays), among, counters);
+        for (i, h) in hits.iter_mut().enumerate() {
+            *h = best.hit(i);
+        }
+    }
+
+    /// The closest hits of the valid rays of `among` in `packet` (the others get none).
+    #[inline(always)]
+    fn closest_of_packet<C: Counters>(&self, packet: &mut PacketRays, among: u32, counters: &mut C) -> PacketBest {
+        let mut best = PacketBest::new(&packet.t_max);
         let among = among & packet.valid;
         if among == 0 || self.nodes().is_empty() {
-            return;
+            return best;
         }
         if !packet::fits(self.depth()) {
-            for i in (0..rays.len()).filter(|&i| among >> i & 1 != 0) {
-                hits[i] = self.closest_hit_of_valid(&rays[i], counters, NoFilter);
+            for i in (0..PACKET).filter(|&i| among >> i & 1 != 0) {
+                if let Some(hit) = self.closest_hit_of_valid(&packet.ray(i), counters, NoFilter) {
+                    best.offer(i, hit);
+                }
             }
-            return;
+            return best;
         }
         // The rays that pass beside the tree's box are dropped first, as a single ray is: a
         // packet none of whose rays enters costs that test and no node.
         let limits = packet.limits();
         let active = among & packet.may_enter(&self.bounds(), &limits);
         if active == 0 {
-            return;
+            return best;
         }
-        packet.bound(rays);
-        let mut leaves = TrianglePacket::new(self, rays, &packet, limits, active);
-        dispatch::closest_packet(self.isa(), self.nodes(), &packet, active, &mut leaves, counters);
-        for (i, h) in hits.iter_mut().enumerate() {
-            *h = leaves.hit(i);
-        }
+        packet.bound(active);
+        let mut leaves = TrianglePacket::new(self, packet, limits, active);
+        dispatch::closest_packet(self.isa(), self.nodes(), packet, active, &mut leaves, counters);
+        leaves.best
+    }
+
+    /// The closest hit of each ray of `rays` in the lanes of `active` (bit per lane), as
+    /// [`TriangleBvh::closest_hit`] gives it for that lane's ray ([`RayPacket::ray`]): the rays
+    /// walk the tree as one packet (see [`TriangleBvh::closest_hit_packet`]), straight from
+    /// their rows. Lanes outside `active`, and lanes whose rays are not valid, get no hit.
+    ///
+    /// ```
+    /// use englobe::{NoCount, RayPacket, TriangleBvh, Vec3};
+    ///
+    /// let bvh = TriangleBvh::from_triangles(&[[Vec3::ZERO, Vec3::X, Vec3::Y]]);
+    /// let mut rays = RayPacket::default();
+    /// for lane in 0..4 {
+    ///     rays.set(lane, Vec3::new(0.1 * lane as f32, 0.1, 1.0), -Vec3::Z, 0.0, f32::INFINITY);
+    /// }
+    /// let hits = bvh.closest_hit_ray_packet(&rays, 0b1111, &mut NoCount);
+    /// assert_eq!(hits.mask(), 0b1111);
+    /// assert_eq!(hits.t[2], 1.0);
+    /// ```
+    pub fn closest_hit_ray_packet<C: Counters>(&self, rays: &RayPacket, active: u32, counters: &mut C) -> PacketHits {
+        let best = self.closest_of_packet(&mut rays.prepare(active), active, counters);
+        PacketHits { t: best.t.0, u: best.u.0, v: best.v.0, prim: best.prim.0.map(f32::to_bits) }
+    }
+
+    /// The lanes of `active` whose rays hit anything, as [`TriangleBvh::any_hit`] tells it for
+    /// each (see [`TriangleBvh::closest_hit_ray_packet`]).
+    pub fn any_hit_ray_packet<C: Counters>(&self, rays: &RayPacket, active: u32, counters: &mut C) -> u32 {
+        self.any_of_packet(&mut rays.prepare(active), active, counters)
     }
 
     /// One packet of 1 to [`PACKET`] rays.
@@ -346,14 +378,19 @@ impl TriangleBvh {
     /// The valid rays of `among` (bits of a packet of 1 to [`PACKET`] rays) that hit something.
     pub(crate) fn any_packet_among<C: Counters>(&self, rays: &[Ray], among: u32, counters: &mut C) -> u32 {
         debug_assert!(rays.len() <= PACKET);
-        let mut packet = PacketRays::new(rays);
+        self.any_of_packet(&mut PacketRays::new(rays), among, counters)
+    }
+
+    /// The valid rays of `among` in `packet` that hit something.
+    #[inline(always)]
+    fn any_of_packet<C: Counters>(&self, packet: &mut PacketRays, among: u32, counters: &mut C) -> u32 {
         let among = among & packet.valid;
         if among == 0 || self.nodes().is_empty() {
             return 0;
         }
         if !packet::fits(self.depth()) {
-            return (0..rays.len())
-                .filter(|&i| among >> i & 1 != 0 && self.any_hit_of_valid(&rays[i], counters, NoFilter))
+            return (0..PACKET)
+                .filter(|&i| among >> i & 1 != 0 && self.any_hit_of_valid(&packet.ray(i), counters, NoFilter))
                 .fold(0, |m, i| m | 1 << i);
         }
         // The rays that pass beside the tree's box are dropped first, as a single ray is: a
@@ -363,8 +400,8 @@ impl TriangleBvh {
         if active == 0 {
             return 0;
         }
-        packet.bound(rays);
-        let mut leaves = TrianglePacket::new(self, rays, &packet, limits, active);
-        dispatch::any_packet(self.isa(), self.nodes(), &packet, active, &mut leaves, counters)
+        packet.bound(active);
+        let mut leaves = TrianglePacket::new(self, packet, limits, active);
+        dispatch::any_packet(self.isa(), self.nodes(), packet, active, &mut leaves, counters)
     }
 }
