@@ -45,24 +45,33 @@ pub struct PacketRays {
     pub interval: Option<PacketInterval>,
 }
 
+/// The lanes whose interval `t_min..=t_max` holds a finite parameter (the interval test of
+/// [`Ray::is_valid`]).
+#[inline(always)]
+pub(super) fn nonempty(t_min: Vec4, t_max: Vec4) -> BVec4A {
+    t_min.cmple(t_max) & t_min.cmplt(Vec4::INFINITY) & t_max.cmpgt(Vec4::NEG_INFINITY)
+}
+
 impl PacketRays {
+    /// No ray: every row zero, no lane valid; what the makers of packets fill in.
+    pub(super) const EMPTY: PacketRays = PacketRays {
+        origin: [Lanes([0.0; PACKET]); 3],
+        dir: [Lanes([0.0; PACKET]); 3],
+        inv_dir: [Lanes([0.0; PACKET]); 3],
+        inv_far: [Lanes([0.0; PACKET]); 3],
+        t_min: Lanes([0.0; PACKET]),
+        t_max: Lanes([0.0; PACKET]),
+        valid: 0,
+        down: [0; 3],
+        interval: None,
+    };
+
     /// Prepares up to [`PACKET`] rays; the lanes beyond `rays.len()` hold zeros, and no query may
     /// ask for them.
     #[inline(always)]
     pub fn new(rays: &[Ray]) -> Self {
         debug_assert!(rays.len() <= PACKET);
-        let zero = Lanes([0.0; PACKET]);
-        let mut p = PacketRays {
-            origin: [zero; 3],
-            dir: [zero; 3],
-            inv_dir: [zero; 3],
-            inv_far: [zero; 3],
-            t_min: zero,
-            t_max: zero,
-            valid: 0,
-            down: [0; 3],
-            interval: None,
-        };
+        let mut p = PacketRays::EMPTY;
         // What `NodeRay::new` computes, four rays at a time: their vectors transposed into rows
         // of four lanes by shuffles, each row stored whole. (Storing each ray's coordinates one
         // by one and reading them back as rows made every read wait for the stores before it.)
@@ -101,8 +110,7 @@ impl PacketRays {
                 & d.y_axis.is_finite_mask()
                 & d.z_axis.is_finite_mask();
             let moving = d.x_axis.cmpne(Vec4::ZERO) | d.y_axis.cmpne(Vec4::ZERO) | d.z_axis.cmpne(Vec4::ZERO);
-            let nonempty = t_min.cmple(t_max) & t_min.cmplt(Vec4::INFINITY) & t_max.cmpgt(Vec4::NEG_INFINITY);
-            p.valid |= (finite & moving & nonempty).bitmask() << (4 * k);
+            p.valid |= (finite & moving & nonempty(t_min, t_max)).bitmask() << (4 * k);
         }
         p
     }

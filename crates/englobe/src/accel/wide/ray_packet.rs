@@ -8,7 +8,7 @@
 
 use glam::{Vec3, Vec4};
 
-use super::packet_rays::{Lanes, PACKET, PacketRays};
+use super::packet_rays::{Lanes, PACKET, PacketRays, nonempty};
 use crate::Ray;
 use crate::accel::Hit;
 use crate::geom::aabb::ROBUST_FAR_SCALE;
@@ -67,18 +67,7 @@ impl RayPacket {
     /// [`PacketRays::new`] makes of the same rays, computed row by row, four lanes at a time.
     #[inline(always)]
     pub(super) fn prepare(&self, active: u32) -> PacketRays {
-        let zero = Lanes([0.0; PACKET]);
-        let mut p = PacketRays {
-            origin: [zero; 3],
-            dir: [zero; 3],
-            inv_dir: [zero; 3],
-            inv_far: [zero; 3],
-            t_min: Lanes(self.t_min),
-            t_max: Lanes(self.t_max),
-            valid: 0,
-            down: [0; 3],
-            interval: None,
-        };
+        let mut p = PacketRays { t_min: Lanes(self.t_min), t_max: Lanes(self.t_max), ..PacketRays::EMPTY };
         for k in 0..PACKET / 4 {
             let lanes = 4 * k..4 * k + 4;
             let four = |row: &[f32; PACKET]| Vec4::from_slice(&row[lanes.clone()]);
@@ -97,8 +86,7 @@ impl RayPacket {
                 moving |= d.cmpne(Vec4::ZERO);
             }
             let (t_min, t_max) = (four(&self.t_min), four(&self.t_max));
-            let nonempty = t_min.cmple(t_max) & t_min.cmplt(Vec4::INFINITY) & t_max.cmpgt(Vec4::NEG_INFINITY);
-            p.valid |= (finite & moving & nonempty).bitmask() << (4 * k);
+            p.valid |= (finite & moving & nonempty(t_min, t_max)).bitmask() << (4 * k);
         }
         p.valid &= active;
         p
