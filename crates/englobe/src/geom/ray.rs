@@ -4,7 +4,7 @@
 //! direction component (of either sign) gets an inverse of `+inf`, never `-inf`: the slab test in
 //! [`crate::Aabb`] relies on that to treat a ray lying in a box face consistently (see there).
 
-use glam::{Vec3, Vec3A};
+use glam::{Vec3, Vec3A, Vec4};
 
 /// A ray `origin + t * dir` for `t` in the closed interval `t_min..=t_max`.
 ///
@@ -115,6 +115,13 @@ impl Ray {
 #[inline(always)]
 fn safe_inverse(x: Vec3A) -> Vec3A {
     Vec3A::select(x.cmpeq(Vec3A::ZERO), Vec3A::INFINITY, Vec3A::ONE / x)
+}
+
+/// [`safe_inverse`] of four lanes of a packet's row (the rays of a packet): the same operations, so
+/// the same bits, lane by lane.
+#[inline(always)]
+pub(crate) fn safe_inverse_lanes(x: Vec4) -> Vec4 {
+    Vec4::select(x.cmpeq(Vec4::ZERO), Vec4::INFINITY, Vec4::ONE / x)
 }
 
 #[cfg(test)]

@@ -142,13 +142,12 @@ impl PacketRays {
     /// no lane at all.
     #[inline(always)]
     fn interval(&self, lanes: u32) -> Option<PacketInterval> {
-        let packet = self;
         if lanes == 0 {
             return None;
         }
         // One way along each axis: the lanes' signs all set or all clear.
         let mut down = 0;
-        for (a, &d) in packet.down.iter().enumerate() {
+        for (a, &d) in self.down.iter().enumerate() {
             match d & lanes {
                 0 => {}
                 d if d == lanes => down |= 1 << a,
@@ -169,7 +168,7 @@ impl PacketRays {
             let (low, high) =
                 (|v| Vec4::select(taken, v, Vec4::INFINITY), |v| Vec4::select(taken, v, Vec4::NEG_INFINITY));
             for a in 0..3 {
-                let (o, inv) = (four(&packet.origin[a]), four(&packet.inv_dir[a]));
+                let (o, inv) = (four(&self.origin[a]), four(&self.inv_dir[a]));
                 let usable = o.is_finite_mask() & inv.is_finite_mask() & inv.cmpne(Vec4::ZERO);
                 if usable.bitmask() & m != m {
                     return None;
@@ -177,7 +176,7 @@ impl PacketRays {
                 (o_lo[a], o_hi[a]) = (o_lo[a].min(low(o)), o_hi[a].max(high(o)));
                 (inv_lo[a], inv_hi[a]) = (inv_lo[a].min(low(inv)), inv_hi[a].max(high(inv)));
             }
-            t_min = t_min.min(low(four(&packet.t_min)));
+            t_min = t_min.min(low(four(&self.t_min)));
         }
         let least = |v: [Vec4; 3]| Vec3A::from_array(v.map(Vec4::min_element));
         let greatest = |v: [Vec4; 3]| Vec3A::from_array(v.map(Vec4::max_element));

@@ -12,6 +12,7 @@ use super::packet_rays::{Lanes, PACKET, PacketRays, nonempty};
 use crate::Ray;
 use crate::accel::Hit;
 use crate::geom::aabb::ROBUST_FAR_SCALE;
+use crate::geom::ray::safe_inverse_lanes;
 
 /// Up to sixteen rays, one row per coordinate: lane `i` of every row is ray `i`. The queries
 /// take a mask of the lanes to trace; the others are never read. A lane whose ray is not valid
@@ -74,9 +75,8 @@ impl RayPacket {
             let (mut finite, mut moving) = (glam::BVec4A::splat(true), glam::BVec4A::splat(false));
             for a in 0..3 {
                 let (o, d) = (four(&self.origin[a]), four(&self.dir[a]));
-                // `Ray::segment`'s inverse: `+inf` for a zero of either sign (a test checks the
-                // bits).
-                let inv = Vec4::select(d.cmpeq(Vec4::ZERO), Vec4::INFINITY, Vec4::ONE / d);
+                // `Ray::segment`'s inverse, four lanes at a time (a test checks the bits).
+                let inv = safe_inverse_lanes(d);
                 o.write_to_slice(&mut p.origin[a].0[lanes.clone()]);
                 d.write_to_slice(&mut p.dir[a].0[lanes.clone()]);
                 inv.write_to_slice(&mut p.inv_dir[a].0[lanes.clone()]);

@@ -71,12 +71,6 @@ impl<'a> TrianglePacket<'a> {
         TriangleLeaves { blocks, source, best: None, t_max: self.best.t.0[i], filter: NoFilter }
     }
 
-    /// Keeps `hit` as ray `i`'s closest if it is closer, or as close with a lower index.
-    #[inline(always)]
-    fn offer(&mut self, i: usize, hit: Hit) {
-        self.best.offer(i, hit);
-    }
-
     /// Tests the blocks from `first` against the rays of `rays` a whole packet at a time; returns
     /// the rays that hit one (with `closest`, their closest hits are kept).
     #[cfg(target_arch = "x86_64")]
@@ -110,7 +104,7 @@ impl<'a> TrianglePacket<'a> {
                     let t_max = self.best.t.0[i];
                     if let Some(h) = TriRay::scalar(&self.packet.ray(i), block, lane, t_max) {
                         found |= 1 << i;
-                        self.offer(i, Hit { t: h.t, prim: block.ids[lane], u: h.u, v: h.v });
+                        self.best.offer(i, Hit { t: h.t, prim: block.ids[lane], u: h.u, v: h.v });
                     }
                 }
             }
@@ -145,7 +139,7 @@ impl<C: Counters> PacketLeaves<C> for TrianglePacket<'_> {
             let ray = Leaves::<C>::prepare(&lane);
             Leaves::<C>::closest(&mut lane, &ray, first, count, counters);
             if let Some(hit) = lane.best {
-                self.offer(i, hit);
+                self.best.offer(i, hit);
             }
             self.limits.0[i] = reach(self.best.t.0[i]);
         }
@@ -194,7 +188,7 @@ impl<C: Counters> PacketLeaves<C> for TrianglePacket<'_> {
             if closest {
                 dispatch::closest(bvh.isa(), bvh.nodes(), bvh.depth(), reference, &node_ray, &mut lane, counters);
                 if let Some(hit) = lane.best {
-                    self.offer(i, hit);
+                    self.best.offer(i, hit);
                 }
                 self.limits.0[i] = reach(self.best.t.0[i]);
             } else {
