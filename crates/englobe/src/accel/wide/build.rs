@@ -323,7 +323,7 @@ mod tests {
 
     #[test]
     fn the_tree_is_the_binary_build_converted() {
-        let triangles = BinnedSah { small_leaf: 4, parallel_partition: true, ..BinnedSah::default() };
+        let triangles = BinnedSah { small_leaf: 4, block: 4, parallel_partition: true, ..BinnedSah::default() };
         for n in [0usize, 1, 2, 4, 5, 7, 9, 100, 5000, 10 * SUBTREES_PARALLEL_MIN as usize] {
             let boxes = scattered(n);
             for max in [8, 16] {

@@ -44,9 +44,10 @@ pub struct TriangleBvhOptions {
 impl Default for TriangleBvhOptions {
     fn default() -> Self {
         TriangleBvhOptions {
-            // Triangles are tested four at a time, in blocks: the parallel partition's order
-            // shows only in leaves of several blocks (which one an any-hit query tests first).
-            builder: BinnedSah { small_leaf: LANES, parallel_partition: true, ..BinnedSah::default() },
+            // Triangles are tested four at a time, in blocks: the SAH counts blocks, and the
+            // parallel partition's order shows only in leaves of several blocks (which one an
+            // any-hit query tests first).
+            builder: BinnedSah { small_leaf: LANES, block: LANES, parallel_partition: true, ..BinnedSah::default() },
             collapse: LANES,
             presplit_percent: DEFAULT_PRESPLIT_PERCENT,
         }

@@ -269,7 +269,8 @@ fn build_sequential<S: Splitter>(
 
 /// Whether splitting a node of surface area `area` over `n` primitives beats making it a leaf,
 /// when the children's boxes' areas times their counts add up to `weighted`: a split costs
-/// `C_t + C_i * weighted / area`, a leaf `C_i * n` (the constants of [`crate::accel::bvh::stats`]). A node
+/// `C_t + C_i * weighted / area`, a leaf `C_i * n`, `n` being the leaf's exact tests (the constants
+/// of [`crate::accel::bvh::stats`]; see [`super::BinnedSah::block`] for tests of several primitives). A node
 /// without area (all its primitives on one point or segment) gains nothing by a split.
 pub fn split_beats_leaf(weighted: f32, area: f32, n: usize) -> bool {
     area > 0.0 && SAH_TRAVERSAL_COST + SAH_INTERSECTION_COST * weighted / area < SAH_INTERSECTION_COST * n as f32
