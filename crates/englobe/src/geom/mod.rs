@@ -3,6 +3,7 @@
 //! nothing of the crate.
 
 pub mod aabb;
+pub mod huge_pages;
 pub mod prefetch;
 pub mod prim_hit;
 pub mod ray;

@@ -14,7 +14,7 @@
 use super::arena::{Arena, Stored};
 use super::node::{EMPTY, LEAF, WideNode, index_of, is_leaf};
 use super::output::{LeafSink, WideLayout};
-use crate::accel::bvh::build::parallel::collect_indexed;
+use crate::accel::bvh::build::parallel::collect_indexed_huge;
 
 /// Where the pieces of one build keep their nodes and leaf items until they are stored together.
 pub(super) struct Store<K: LeafSink> {
@@ -94,7 +94,7 @@ impl<K: LeafSink + Send + Sync> Pieces<K> {
             first_item.push(sink.append(store.items.get(&piece.items)));
             parts.push((piece.nodes, piece.links));
         }
-        let nodes = collect_indexed(total as usize, 1 << 10, |i| {
+        let nodes = collect_indexed_huge(total as usize, 1 << 10, |i| {
             // The piece holding node `i`: the last one starting at or before it.
             let p = first_node.partition_point(|&f| f as usize <= i) - 1;
             let (nodes, links) = &parts[p];

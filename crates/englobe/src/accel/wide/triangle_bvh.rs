@@ -18,7 +18,7 @@ use super::presplit::{TriangleBox, presplit_cuts};
 use super::traverse::Leaves;
 use super::triangles::{LANES, TriBlock, TriRay, UNUSED, intersect_block, is_storable};
 use crate::accel::bvh::BinnedSah;
-use crate::accel::bvh::build::parallel::{collect_indexed, map_chunks};
+use crate::accel::bvh::build::parallel::{collect_indexed, collect_indexed_huge, map_chunks};
 use crate::accel::{Counters, Hit, HitFilter, LEAF_SIZE_BUCKETS, MAX_PRIMITIVES, NoFilter, StructureStats};
 use crate::geom::prefetch::prefetch;
 use crate::shapes::{MeshError, TriangleMesh, check_arrays};
@@ -149,7 +149,7 @@ impl Blocks<'_> {
     /// leaves' order, not the mesh's, so they mostly miss the caches, and they were the largest
     /// sequential part of a build.
     fn fill(&self, triangle: impl Fn(u32) -> [Vec3; 3] + Sync) -> Vec<TriBlock> {
-        collect_indexed(self.blocks.len(), 1 << 12, |i| {
+        collect_indexed_huge(self.blocks.len(), 1 << 12, |i| {
             let ids = &self.blocks[i];
             let used = ids.iter().take_while(|&&id| id != UNUSED).count();
             let mut triangles = [(UNUSED, [Vec3::ZERO; 3]); LANES];

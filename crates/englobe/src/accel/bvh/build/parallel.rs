@@ -51,6 +51,23 @@ pub fn collect_indexed<T: Send>(n: usize, min_chunk: usize, f: impl Fn(usize) ->
     (0..n).map(f).collect()
 }
 
+/// [`collect_indexed`] into memory asked to be backed by huge pages before the first value is
+/// written ([`crate::geom::huge_pages`]): for the arrays that queries read at random.
+pub fn collect_indexed_huge<T: Send>(n: usize, min_chunk: usize, f: impl Fn(usize) -> T + Sync) -> Vec<T> {
+    let mut values = Vec::with_capacity(n);
+    crate::geom::huge_pages::advise(values.as_ptr() as *const u8, n * std::mem::size_of::<T>());
+    #[cfg(feature = "parallel")]
+    if n > min_chunk {
+        use rayon::prelude::*;
+        // Into the vector's own allocation: `collect_into_vec` keeps a capacity that suffices.
+        (0..n).into_par_iter().with_min_len(min_chunk.max(1)).map(&f).collect_into_vec(&mut values);
+        return values;
+    }
+    let _ = min_chunk;
+    values.extend((0..n).map(f));
+    values
+}
+
 /// `f` of each of `items`, in order; in parallel, one task per item, when the `parallel` feature
 /// is on (for a few large pieces of work).
 #[inline]
@@ -136,5 +153,16 @@ mod tests {
         assert_eq!(firsts, [0, 3000, 6000, 9000]);
         assert_eq!(map_chunks(&v, 700, |c| c.len()), [[700; 14].as_slice(), &[200]].concat());
         assert!(map_chunks(&[] as &[u32], 7, |c| c.len()).is_empty());
+    }
+
+    #[test]
+    fn values_on_huge_pages_are_the_values() {
+        // Below the size of a huge page, and above it (12 MB: the advice is taken).
+        for n in [0, 5, 100_000, 1_500_000] {
+            let f = |i: usize| [i as u64, (i as u64).wrapping_mul(2_654_435_761)];
+            let huge = collect_indexed_huge(n, 1024, f);
+            assert!(huge.capacity() >= n);
+            assert_eq!(huge, collect_indexed(n, 1024, f), "{n} values");
+        }
     }
 }
