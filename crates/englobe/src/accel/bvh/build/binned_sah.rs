@@ -258,6 +258,13 @@ fn weighted_areas(sides: &[Bin; 3], counts: IVec4) -> (Vec4, Vec4) {
     (Vec4::splat(2.0) * (ex * ey + ey * ez + ez * ex) * count, count)
 }
 
+/// `count` primitives tested `2^shift` at a time: `ceil(count / 2^shift)` tests per lane, for counts
+/// from 0 to `i32::MAX` (written so that nothing overflows: `(count - 1) >> shift` is -1 for none).
+#[inline(always)]
+fn tests_of(count: IVec4, shift: u32) -> IVec4 {
+    ((count - IVec4::ONE) >> shift) + IVec4::ONE
+}
+
 /// The best plane among the first `k` bins of each axis that `splittable` allows: (area-weighted
 /// count of both sides, axis, first bin of the second side), each side's count being its blocks
 /// of `2^shift` primitives (see [`BinnedSah::block`]). The three axes are swept at once,
@@ -265,7 +272,7 @@ fn weighted_areas(sides: &[Bin; 3], counts: IVec4) -> (Vec4, Vec4) {
 /// and the axes are then compared in order, so the plane is the one a sweep of axis 0, then 1,
 /// then 2 would keep (the first of least cost).
 fn best_plane(bins: &Bins, k: usize, splittable: [bool; 3], shift: u32) -> Option<(f32, usize, usize)> {
-    let blocks = |count: IVec4| (count + IVec4::splat((1 << shift) - 1)) >> shift;
+    let blocks = |count: IVec4| tests_of(count, shift);
     // right[i]: area times count of bins i.. of each axis (for the planes before bin i, i in
     // 1..k), NaN where they are empty.
     let mut right = [Vec4::NAN; MAX_BINS];
@@ -410,6 +417,16 @@ mod tests {
         let builder = BinnedSah { bins: 8, max_leaf: 3, small_leaf: 0, block: 1, parallel_partition: false };
         let q = validate_bvh(&builder.build(&boxes), &boxes).unwrap();
         assert!(q.max_leaf <= 3 && q.leaves >= 3, "{q:?}");
+    }
+
+    #[test]
+    fn tests_are_counted_in_blocks_without_overflow() {
+        for shift in 0..=6u32 {
+            for n in [0, 1, 2, 3, 4, 5, 63, 64, 65, 1 << 20, i32::MAX - 64, i32::MAX] {
+                let expected = (n as u32).div_ceil(1 << shift) as i32;
+                assert_eq!(tests_of(IVec4::splat(n), shift), IVec4::splat(expected), "{n} in blocks of 2^{shift}");
+            }
+        }
     }
 
     #[test]
