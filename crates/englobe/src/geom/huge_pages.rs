@@ -17,10 +17,15 @@ const HUGE_PAGE: usize = 2 << 20;
 pub fn advise(start: *const u8, bytes: usize) {
     #[cfg(target_os = "linux")]
     if bytes >= HUGE_PAGE {
-        // The advice applies to whole pages: the ones inside the range.
-        const PAGE: usize = 4096;
-        let first = (start as usize).next_multiple_of(PAGE);
-        let end = (start as usize + bytes) / PAGE * PAGE;
+        // The advice applies to whole pages: the ones inside the range (4 KiB on x86-64, 16 or
+        // 64 KiB on some ARM systems).
+        // SAFETY: `sysconf` only reads a system setting.
+        let Ok(page) = usize::try_from(unsafe { libc::sysconf(libc::_SC_PAGESIZE) }) else { return };
+        if page == 0 {
+            return;
+        }
+        let first = (start as usize).next_multiple_of(page);
+        let end = (start as usize + bytes) / page * page;
         if end > first {
             // SAFETY: `madvise` with `MADV_HUGEPAGE` changes how the pages of a mapping the
             // caller owns are backed, never their contents or whether they can be read; the
