@@ -272,7 +272,6 @@ fn tests_of(count: IVec4, shift: u32) -> IVec4 {
 /// and the axes are then compared in order, so the plane is the one a sweep of axis 0, then 1,
 /// then 2 would keep (the first of least cost).
 fn best_plane(bins: &Bins, k: usize, splittable: [bool; 3], shift: u32) -> Option<(f32, usize, usize)> {
-    let blocks = |count: IVec4| tests_of(count, shift);
     // right[i]: area times count of bins i.. of each axis (for the planes before bin i, i in
     // 1..k), NaN where they are empty.
     let mut right = [Vec4::NAN; MAX_BINS];
@@ -282,7 +281,7 @@ fn best_plane(bins: &Bins, k: usize, splittable: [bool; 3], shift: u32) -> Optio
             s.merge(&axis[i]);
         }
         side_count += bins.counts[i];
-        let (weighted, count) = weighted_areas(&side, blocks(side_count));
+        let (weighted, count) = weighted_areas(&side, tests_of(side_count, shift));
         right[i] = Vec4::select(count.cmpeq(Vec4::ZERO), Vec4::NAN, weighted);
     }
     let allowed = BVec4A::new(splittable[0], splittable[1], splittable[2], false);
@@ -293,7 +292,7 @@ fn best_plane(bins: &Bins, k: usize, splittable: [bool; 3], shift: u32) -> Optio
             s.merge(&axis[i - 1]);
         }
         side_count += bins.counts[i - 1];
-        let (weighted, count) = weighted_areas(&side, blocks(side_count));
+        let (weighted, count) = weighted_areas(&side, tests_of(side_count, shift));
         let valid = allowed & count.cmpne(Vec4::ZERO) & !right[i].is_nan_mask();
         let here = weighted + right[i];
         let better = valid & (!found | here.cmplt(cost));

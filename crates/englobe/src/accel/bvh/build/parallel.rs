@@ -42,24 +42,29 @@ pub fn fill_indexed<T: Send>(out: &mut [T], min_chunk: usize, f: impl Fn(usize) 
 /// where filling a vector made by `vec![x; n]` would first take them all on one.
 #[inline]
 pub fn collect_indexed<T: Send>(n: usize, min_chunk: usize, f: impl Fn(usize) -> T + Sync) -> Vec<T> {
-    #[cfg(feature = "parallel")]
-    if n > min_chunk {
-        use rayon::prelude::*;
-        return (0..n).into_par_iter().with_min_len(min_chunk.max(1)).map(&f).collect();
-    }
-    let _ = min_chunk;
-    (0..n).map(f).collect()
+    collect_indexed_into(Vec::new(), n, min_chunk, f)
 }
 
 /// [`collect_indexed`] into memory asked to be backed by huge pages before the first value is
 /// written ([`crate::geom::huge_pages`]): for the arrays that queries read at random.
 pub fn collect_indexed_huge<T: Send>(n: usize, min_chunk: usize, f: impl Fn(usize) -> T + Sync) -> Vec<T> {
-    let mut values = Vec::with_capacity(n);
+    let values = Vec::with_capacity(n);
     crate::geom::huge_pages::advise(values.as_ptr() as *const u8, n * std::mem::size_of::<T>());
+    collect_indexed_into(values, n, min_chunk, f)
+}
+
+/// [`collect_indexed`] into `values` (empty), in its own allocation if its capacity suffices.
+#[inline]
+fn collect_indexed_into<T: Send>(
+    mut values: Vec<T>,
+    n: usize,
+    min_chunk: usize,
+    f: impl Fn(usize) -> T + Sync,
+) -> Vec<T> {
     #[cfg(feature = "parallel")]
     if n > min_chunk {
         use rayon::prelude::*;
-        // Into the vector's own allocation: `collect_into_vec` keeps a capacity that suffices.
+        // `collect_into_vec` keeps the vector's allocation when its capacity suffices.
         (0..n).into_par_iter().with_min_len(min_chunk.max(1)).map(&f).collect_into_vec(&mut values);
         return values;
     }
@@ -157,7 +162,7 @@ mod tests {
 
     #[test]
     fn values_on_huge_pages_are_the_values() {
-        // Below the size of a huge page, and above it (12 MB: the advice is taken).
+        // Below the size of a huge page, and above it (24 MB: the advice is given).
         for n in [0, 5, 100_000, 1_500_000] {
             let f = |i: usize| [i as u64, (i as u64).wrapping_mul(2_654_435_761)];
             let huge = collect_indexed_huge(n, 1024, f);
