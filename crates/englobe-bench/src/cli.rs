@@ -17,6 +17,8 @@ pub const MAX_RESOLUTION: u32 = 4096;
 pub const MAX_RAY_COUNT: usize = 1 << 24;
 /// Most threads accepted.
 pub const MAX_THREADS: usize = 1024;
+/// Largest pre-split budget accepted, in percent more references (ten times the triangles).
+pub const MAX_PRESPLIT_PERCENT: u32 = 1000;
 
 /// Measure englobe against Intel Embree, obvhs and bvh on the same rays.
 #[derive(Args, Clone, Debug)]
@@ -46,6 +48,10 @@ pub struct BenchArgs {
     /// englobe's structure (default: the best this build of englobe has).
     #[arg(long, value_parser = EnglobeStructure::parse, value_name = "NAME")]
     pub englobe_accel: Option<EnglobeStructure>,
+    /// Pre-split budget of englobe's triangle BVH, in percent more references than triangles
+    /// (default: the library's, `TriangleBvhOptions::default()`; 0 cuts no triangle).
+    #[arg(long, value_name = "PERCENT")]
+    pub englobe_presplit: Option<u32>,
     /// Cells to measure, comma-separated, or `all` (default: primary-closest, random-closest,
     /// random-any, bounce-closest).
     #[arg(long, value_delimiter = ',')]
@@ -119,6 +125,9 @@ impl BenchArgs {
         }
         if self.rays == 0 || self.rays > MAX_RAY_COUNT {
             return Err(format!("--rays must be between 1 and {MAX_RAY_COUNT}"));
+        }
+        if self.englobe_presplit.is_some_and(|p| p > MAX_PRESPLIT_PERCENT) {
+            return Err(format!("--englobe-presplit must be at most {MAX_PRESPLIT_PERCENT} (percent more references)"));
         }
         if !(0.0..=1.0).contains(&self.tolerance) {
             return Err("--tolerance is a fraction between 0 and 1".into());

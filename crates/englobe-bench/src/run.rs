@@ -32,7 +32,10 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<ExitCode> {
     if libraries.is_empty() {
         bail!("no library to measure");
     }
-    let englobe = args.englobe_accel.unwrap_or_else(EnglobeStructure::best);
+    let mut englobe = args.englobe_accel.unwrap_or_else(EnglobeStructure::best);
+    if let Some(percent) = args.englobe_presplit {
+        englobe = englobe.with_presplit(percent).map_err(|e| anyhow!(e))?;
+    }
     let max_threads = *args.threads.iter().max().expect("validated: at least one thread count");
     let progress = |msg: String| {
         if !args.quiet {

@@ -113,6 +113,8 @@ fn bad_input_is_refused_with_a_clear_error() {
         (vec![box_.as_str(), "--libraries", "optix"], "unknown library"),
         (vec![box_.as_str(), "--cells", "shadow-any"], "unknown cell"),
         (vec![box_.as_str(), "--englobe-accel", "octree"], "unknown accelerator"),
+        (vec![box_.as_str(), "--englobe-presplit", "5000"], "--englobe-presplit must be at most"),
+        (vec![box_.as_str(), "--englobe-accel", "bvh-sah", "--englobe-presplit", "0"], "only triangle-bvh"),
     ] {
         let out = bench(&args);
         assert!(!out.status.success());

@@ -9,25 +9,35 @@
 //!     ../shared/scenes/meshes/bunny/stanford-bunny.obj ../shared/scenes/meshes/ogre/ogre.obj \
 //!     ../shared/scenes/meshes/sponza-dabrovic/sponza.obj
 //! ```
+//!
+//! `--presplit PERCENT` first builds with that pre-split budget instead of the library's default.
 
 use std::path::Path;
 use std::time::Instant;
 
 use anyhow::Context;
+use englobe::accel::wide::triangle_bvh::TriangleBvhOptions;
 use englobe::{Ray, TriangleBvh, Vec3, WorkCounts};
 use englobe_scene::mesh::load_mesh_file;
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg32;
 
 fn main() -> anyhow::Result<()> {
-    for path in std::env::args().skip(1) {
+    let mut args: Vec<String> = std::env::args().skip(1).collect();
+    let mut options = TriangleBvhOptions::default();
+    if args.first().is_some_and(|a| a == "--presplit") {
+        let percent = args.get(1).context("--presplit needs a percentage")?;
+        options.presplit_percent = percent.parse().with_context(|| format!("--presplit {percent}"))?;
+        args.drain(..2);
+    }
+    for path in args {
         let loaded = load_mesh_file(Path::new(&path)).with_context(|| path.clone())?;
         let mesh = loaded.mesh;
         let mut times = Vec::new();
         let mut bvh = None;
         for _ in 0..5 {
             let start = Instant::now();
-            bvh = Some(TriangleBvh::build(&mesh));
+            bvh = Some(TriangleBvh::build_with(mesh.len(), |i| mesh.triangle(i).vertices, options));
             times.push(start.elapsed().as_secs_f64());
         }
         times.sort_by(f64::total_cmp);

@@ -1,6 +1,7 @@
 //! englobe under test. The structure is chosen by name (`--englobe-accel`): the triangle fast
 //! path [`TriangleBvh`] (`triangle-bvh`, the default; `triangle-bvh-avx2` and so on to pin an
-//! instruction set), or any [`AccelKind`] queried through [`World`]. To add another: give
+//! instruction set; `--englobe-presplit` sets its pre-split budget), or any [`AccelKind`] queried
+//! through [`World`]. To add another: give
 //! [`EnglobeStructure`] a variant, parse its name in [`EnglobeStructure::parse`], and build and
 //! query it in [`EnglobeLibrary`]; the harness, the agreement checks and the tables need nothing
 //! else.
@@ -12,6 +13,7 @@ use std::fmt;
 
 use englobe::accel::wide::Isa;
 use englobe::accel::wide::packet_kernels::PACKET;
+use englobe::accel::wide::triangle_bvh::TriangleBvhOptions;
 use englobe::{AccelKind, NoCount, Object, PacketHits, RayPacket, TriangleBvh, World};
 
 use crate::library::{BenchRay, Library, RayResult};
@@ -30,8 +32,13 @@ pub enum EnglobeStructure {
     /// A structure of [`AccelKind`], queried through [`World`] with a mesh object.
     World(AccelKind),
     /// The wide BVH over blocks of triangles, with the processor's best instruction set or the
-    /// one given.
-    Triangles(Option<Isa>),
+    /// one given, and the library's pre-split budget or the one given.
+    Triangles {
+        /// The instruction set, if not the processor's best.
+        isa: Option<Isa>,
+        /// [`TriangleBvhOptions::presplit_percent`], if not the library's default.
+        presplit_percent: Option<u32>,
+    },
 }
 
 impl EnglobeStructure {
@@ -46,7 +53,7 @@ impl EnglobeStructure {
     /// The structure called `name`.
     pub fn parse(name: &str) -> Result<Self, String> {
         if name == TRIANGLE_BVH {
-            return Ok(EnglobeStructure::Triangles(None));
+            return Ok(EnglobeStructure::Triangles { isa: None, presplit_percent: None });
         }
         if let Some(isa) = name.strip_prefix(TRIANGLE_BVH).and_then(|rest| rest.strip_prefix('-')) {
             let isa = Isa::ALL.into_iter().find(|i| i.name() == isa).ok_or_else(|| {
@@ -56,7 +63,7 @@ impl EnglobeStructure {
             if !isa.is_available() {
                 return Err(format!("`{name}`: this processor cannot run the {isa} kernels"));
             }
-            return Ok(EnglobeStructure::Triangles(Some(isa)));
+            return Ok(EnglobeStructure::Triangles { isa: Some(isa), presplit_percent: None });
         }
         name.parse::<AccelKind>()
             .map(EnglobeStructure::World)
@@ -67,8 +74,20 @@ impl EnglobeStructure {
     pub fn name(&self) -> String {
         match self {
             EnglobeStructure::World(kind) => kind.name().to_owned(),
-            EnglobeStructure::Triangles(None) => TRIANGLE_BVH.to_owned(),
-            EnglobeStructure::Triangles(Some(isa)) => format!("{TRIANGLE_BVH}-{isa}"),
+            EnglobeStructure::Triangles { isa: None, .. } => TRIANGLE_BVH.to_owned(),
+            EnglobeStructure::Triangles { isa: Some(isa), .. } => format!("{TRIANGLE_BVH}-{isa}"),
+        }
+    }
+
+    /// The same structure built with a pre-split budget of `percent` (the triangle BVH only).
+    pub fn with_presplit(self, percent: u32) -> Result<Self, String> {
+        match self {
+            EnglobeStructure::Triangles { isa, .. } => {
+                Ok(EnglobeStructure::Triangles { isa, presplit_percent: Some(percent) })
+            }
+            EnglobeStructure::World(kind) => {
+                Err(format!("--englobe-presplit: `{}` has no pre-split; only {TRIANGLE_BVH} has", kind.name()))
+            }
         }
     }
 }
@@ -108,8 +127,14 @@ impl EnglobeLibrary {
                 let world = World::build(vec![Object::Mesh(scene.mesh.clone())], kind)?;
                 Ok(EnglobeLibrary { structure, built: Built::World(Box::new(world)), packets: false })
             }
-            EnglobeStructure::Triangles(isa) => {
-                let mut bvh = TriangleBvh::build(&scene.mesh);
+            EnglobeStructure::Triangles { isa, presplit_percent } => {
+                let defaults = TriangleBvhOptions::default();
+                let options = TriangleBvhOptions {
+                    presplit_percent: presplit_percent.unwrap_or(defaults.presplit_percent),
+                    ..defaults
+                };
+                let mesh = &scene.mesh;
+                let mut bvh = TriangleBvh::build_with(mesh.len(), |i| mesh.triangle(i).vertices, options);
                 if let Some(isa) = isa {
                     bvh.set_isa(isa)?;
                 }
@@ -123,7 +148,7 @@ impl EnglobeLibrary {
     /// `rtcIntersect16` is.
     pub fn build_packets(scene: &BenchScene, structure: EnglobeStructure) -> anyhow::Result<Self> {
         let structure = match structure {
-            EnglobeStructure::World(_) => EnglobeStructure::Triangles(None),
+            EnglobeStructure::World(_) => EnglobeStructure::Triangles { isa: None, presplit_percent: None },
             triangles => triangles,
         };
         Ok(EnglobeLibrary { packets: true, ..Self::build(scene, structure)? })
@@ -145,12 +170,16 @@ impl Library for EnglobeLibrary {
     }
 
     fn structure(&self) -> String {
+        let presplit = match self.structure {
+            EnglobeStructure::Triangles { presplit_percent: Some(p), .. } => format!("; pre-split {p} %"),
+            _ => String::new(),
+        };
         if let (true, Built::Triangles(bvh)) = (self.packets, &self.built) {
-            return format!("{TRIANGLE_BVH} ({}), 16-ray packets", bvh.isa());
+            return format!("{TRIANGLE_BVH} ({}{presplit}), 16-ray packets", bvh.isa());
         }
         match (&self.structure, &self.built) {
             (EnglobeStructure::World(kind), _) => format!("{} through World", kind.name()),
-            (_, Built::Triangles(bvh)) => format!("{TRIANGLE_BVH} ({})", bvh.isa()),
+            (_, Built::Triangles(bvh)) => format!("{TRIANGLE_BVH} ({}{presplit})", bvh.isa()),
             (_, Built::World(_)) => self.structure.name(),
         }
     }
@@ -221,12 +250,39 @@ mod tests {
     fn the_best_structure_is_known_and_names_round_trip() {
         let best = EnglobeStructure::best();
         assert_eq!(EnglobeStructure::parse(&best.name()).unwrap(), best);
-        assert_eq!(best, EnglobeStructure::Triangles(None));
+        assert_eq!(best, EnglobeStructure::Triangles { isa: None, presplit_percent: None });
         assert!(EnglobeStructure::parse("octree").is_err());
         assert!(EnglobeStructure::parse("triangle-bvh-sse9").is_err());
         for isa in Isa::available() {
             let s = EnglobeStructure::parse(&format!("triangle-bvh-{isa}")).unwrap();
-            assert_eq!((s, EnglobeStructure::parse(&s.name()).unwrap()), (EnglobeStructure::Triangles(Some(isa)), s));
+            assert_eq!(
+                (s, EnglobeStructure::parse(&s.name()).unwrap()),
+                (EnglobeStructure::Triangles { isa: Some(isa), presplit_percent: None }, s)
+            );
         }
+    }
+
+    #[test]
+    fn the_presplit_budget_reaches_the_build_and_the_label() {
+        let meshes =
+            englobe_scene::shared_data::shared_meshes_or_panic(std::path::Path::new(env!("CARGO_MANIFEST_DIR")));
+        let scene = BenchScene::load("sponza", &meshes.join("sponza-dabrovic/sponza.obj"), None).unwrap();
+        let references = |presplit_percent| {
+            let structure = EnglobeStructure::Triangles { isa: None, presplit_percent };
+            let library = EnglobeLibrary::build(&scene, structure).unwrap();
+            let Built::Triangles(bvh) = &library.built else { panic!("a triangle BVH") };
+            (bvh.stats().prim_refs, library.structure())
+        };
+        let triangles = scene.mesh.len();
+        // The atrium's walls and floors are long triangles whose boxes waste area: the default
+        // budget cuts some of them, a budget of 0 none.
+        let (default_refs, default_label) = references(None);
+        let (uncut, uncut_label) = references(Some(0));
+        assert!(default_refs > triangles, "{default_refs} references for {triangles} triangles");
+        assert_eq!(uncut, triangles);
+        assert!(!default_label.contains("pre-split"), "{default_label}");
+        assert!(uncut_label.ends_with("; pre-split 0 %)"), "{uncut_label}");
+        let world = EnglobeStructure::parse("bvh-sah").unwrap();
+        assert!(world.with_presplit(0).unwrap_err().contains("only triangle-bvh"));
     }
 }
