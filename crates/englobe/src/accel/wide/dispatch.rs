@@ -116,6 +116,35 @@ pub fn any_packet<C: Counters, L: PacketLeaves<C>>(
     }
 }
 
+/// A whole packet query, from the rays as the caller hands them over to the answers: compiled by
+/// [`packet_query`] with the structure's instruction set, so that the rays' preparation (the
+/// inverse directions, the checks, the packet's bounds) runs with the same vector instructions as
+/// the walk rather than the target's baseline.
+pub trait PacketQuery {
+    /// What the query returns.
+    type Output;
+    /// Runs the query. Implementations are `#[inline(always)]`, so that their body is compiled
+    /// into the copy that calls them (a closure would be compiled without its features).
+    fn run(self) -> Self::Output;
+}
+
+/// Runs `query` compiled for `isa`, which the processor must have (see the module documentation).
+#[inline(always)]
+pub fn packet_query<Q: PacketQuery>(isa: Isa, query: Q) -> Q::Output {
+    debug_assert!(isa.is_available());
+    match isa {
+        Isa::Portable => query.run(),
+        // SAFETY: the structure's instruction set is one the processor has (module documentation).
+        #[cfg(target_arch = "x86_64")]
+        Isa::Avx2 => unsafe { x86::packet_query_avx2(query) },
+        // SAFETY: as above.
+        #[cfg(target_arch = "x86_64")]
+        Isa::Avx512 => unsafe { x86::packet_query_avx512(query) },
+        #[cfg(not(target_arch = "x86_64"))]
+        _ => unreachable!("x86 instruction sets are never available elsewhere"),
+    }
+}
+
 /// The portable copies, compiled apart like the others rather than inlined into every caller:
 /// inlined, their code and stack would weigh on the caller's registers and frame on machines that
 /// run another copy.
@@ -179,6 +208,20 @@ mod x86 {
     use super::super::kernels::{Avx2, Avx512};
     use super::super::packet_kernels::{Avx2Packet, Avx512Packet};
     use super::*;
+
+    /// # Safety
+    /// The processor has AVX2, FMA and the bit instructions that come with them (see `Isa`).
+    #[target_feature(enable = "avx2,fma,bmi1,bmi2,lzcnt,popcnt")]
+    pub unsafe fn packet_query_avx2<Q: PacketQuery>(query: Q) -> Q::Output {
+        query.run()
+    }
+
+    /// # Safety
+    /// The processor has AVX-512 F, VL, BW and DQ (and AVX2).
+    #[target_feature(enable = "avx2,fma,bmi1,bmi2,lzcnt,popcnt,avx512f,avx512vl,avx512bw,avx512dq")]
+    pub unsafe fn packet_query_avx512<Q: PacketQuery>(query: Q) -> Q::Output {
+        query.run()
+    }
 
     /// # Safety
     /// The processor has AVX2, FMA and the bit instructions that come with them (see `Isa`).

@@ -296,8 +296,7 @@ impl TriangleBvh {
         counters: &mut C,
     ) {
         debug_assert!(rays.len() <= PACKET && rays.len() == hits.len());
-        // The rays' checks come with their transposition, four at a time.
-        let best = self.closest_of_packet(&mut PacketRays::new(rays), among, counters);
+        let best = self.closest_query(PacketSource::Slice(rays), among, counters);
         for (i, h) in hits.iter_mut().enumerate() {
             *h = best.hit(i);
         }
@@ -350,14 +349,14 @@ impl TriangleBvh {
     /// assert_eq!(hits.t[2], 1.0);
     /// ```
     pub fn closest_hit_ray_packet<C: Counters>(&self, rays: &RayPacket, active: u32, counters: &mut C) -> PacketHits {
-        let best = self.closest_of_packet(&mut rays.prepare(active), active, counters);
+        let best = self.closest_query(PacketSource::Rows(rays), active, counters);
         PacketHits { t: best.t.0, u: best.u.0, v: best.v.0, prim: best.prim.0.map(f32::to_bits) }
     }
 
     /// The lanes of `active` whose rays hit anything, as [`TriangleBvh::any_hit`] tells it for
     /// each (see [`TriangleBvh::closest_hit_ray_packet`]).
     pub fn any_hit_ray_packet<C: Counters>(&self, rays: &RayPacket, active: u32, counters: &mut C) -> u32 {
-        self.any_of_packet(&mut rays.prepare(active), active, counters)
+        self.any_query(PacketSource::Rows(rays), active, counters)
     }
 
     /// One packet of 1 to [`PACKET`] rays.
@@ -372,7 +371,19 @@ impl TriangleBvh {
     /// The valid rays of `among` (bits of a packet of 1 to [`PACKET`] rays) that hit something.
     pub(crate) fn any_packet_among<C: Counters>(&self, rays: &[Ray], among: u32, counters: &mut C) -> u32 {
         debug_assert!(rays.len() <= PACKET);
-        self.any_of_packet(&mut PacketRays::new(rays), among, counters)
+        self.any_query(PacketSource::Slice(rays), among, counters)
+    }
+
+    /// The closest hits of the valid rays of `among` in `source`, the whole query (the rays'
+    /// preparation included) compiled for the structure's instruction set (see
+    /// [`dispatch::packet_query`]).
+    fn closest_query<C: Counters>(&self, source: PacketSource, among: u32, counters: &mut C) -> PacketBest {
+        dispatch::packet_query(self.isa(), ClosestQuery { bvh: self, source, among, counters })
+    }
+
+    /// The valid rays of `among` in `source` that hit something (see [`TriangleBvh::closest_query`]).
+    fn any_query<C: Counters>(&self, source: PacketSource, among: u32, counters: &mut C) -> u32 {
+        dispatch::packet_query(self.isa(), AnyQuery { bvh: self, source, among, counters })
     }
 
     /// The valid rays of `among` in `packet` that hit something.
@@ -397,5 +408,61 @@ impl TriangleBvh {
         packet.bound(active);
         let mut leaves = TrianglePacket::new(self, packet, limits, active);
         dispatch::any_packet(self.isa(), self.nodes(), packet, active, &mut leaves, counters)
+    }
+}
+
+/// Where a packet's rays come from.
+#[derive(Clone, Copy)]
+enum PacketSource<'a> {
+    /// Rows, as [`RayPacket`] holds them.
+    Rows(&'a RayPacket),
+    /// One to [`PACKET`] rays.
+    Slice(&'a [Ray]),
+}
+
+impl PacketSource<'_> {
+    /// The rays prepared for the walk, valid only in `among`.
+    #[inline(always)]
+    fn prepare(self, among: u32) -> PacketRays {
+        match self {
+            PacketSource::Rows(rows) => rows.prepare(among),
+            // The rays' checks come with their transposition, four at a time.
+            PacketSource::Slice(rays) => PacketRays::new(rays),
+        }
+    }
+}
+
+/// A closest-hit packet query as [`dispatch::packet_query`] runs it: the rays prepared (checked,
+/// inverted, bounded), then walked.
+struct ClosestQuery<'a, C> {
+    bvh: &'a TriangleBvh,
+    source: PacketSource<'a>,
+    among: u32,
+    counters: &'a mut C,
+}
+
+impl<C: Counters> dispatch::PacketQuery for ClosestQuery<'_, C> {
+    type Output = PacketBest;
+
+    #[inline(always)]
+    fn run(self) -> PacketBest {
+        self.bvh.closest_of_packet(&mut self.source.prepare(self.among), self.among, self.counters)
+    }
+}
+
+/// An any-hit packet query (see [`ClosestQuery`]): the rays that hit something.
+struct AnyQuery<'a, C> {
+    bvh: &'a TriangleBvh,
+    source: PacketSource<'a>,
+    among: u32,
+    counters: &'a mut C,
+}
+
+impl<C: Counters> dispatch::PacketQuery for AnyQuery<'_, C> {
+    type Output = u32;
+
+    #[inline(always)]
+    fn run(self) -> u32 {
+        self.bvh.any_of_packet(&mut self.source.prepare(self.among), self.among, self.counters)
     }
 }
