@@ -5,6 +5,8 @@
 //! gets exactly the answer of its own query. Batches choose, sixteen rays at a time, between a
 //! packet (coherent rays: near origins, near directions) and single rays.
 
+use std::marker::PhantomData;
+
 use super::dispatch;
 use super::isa::Isa;
 use super::node::{NodeRay, reach};
@@ -378,12 +380,12 @@ impl TriangleBvh {
     /// preparation included) compiled for the structure's instruction set (see
     /// [`dispatch::packet_query`]).
     fn closest_query<C: Counters>(&self, source: PacketSource, among: u32, counters: &mut C) -> PacketBest {
-        dispatch::packet_query(self.isa(), ClosestQuery { bvh: self, source, among, counters })
+        dispatch::packet_query(self.isa(), PacketJob::<C, Closest>::new(self, source, among, counters))
     }
 
     /// The valid rays of `among` in `source` that hit something (see [`TriangleBvh::closest_query`]).
     fn any_query<C: Counters>(&self, source: PacketSource, among: u32, counters: &mut C) -> u32 {
-        dispatch::packet_query(self.isa(), AnyQuery { bvh: self, source, among, counters })
+        dispatch::packet_query(self.isa(), PacketJob::<C, Any>::new(self, source, among, counters))
     }
 
     /// The valid rays of `among` in `packet` that hit something.
@@ -432,16 +434,29 @@ impl PacketSource<'_> {
     }
 }
 
-/// A closest-hit packet query as [`dispatch::packet_query`] runs it: the rays prepared (checked,
-/// inverted, bounded), then walked.
-struct ClosestQuery<'a, C> {
+/// A packet query as [`dispatch::packet_query`] runs it: the rays prepared (checked, inverted,
+/// bounded), then walked for their closest hits ([`Closest`]) or for any hit ([`Any`]).
+struct PacketJob<'a, C, K> {
     bvh: &'a TriangleBvh,
     source: PacketSource<'a>,
     among: u32,
     counters: &'a mut C,
+    kind: PhantomData<K>,
 }
 
-impl<C: Counters> dispatch::PacketQuery for ClosestQuery<'_, C> {
+/// A [`PacketJob`] for the closest hits.
+struct Closest;
+
+/// A [`PacketJob`] for the rays that hit anything.
+struct Any;
+
+impl<'a, C, K> PacketJob<'a, C, K> {
+    fn new(bvh: &'a TriangleBvh, source: PacketSource<'a>, among: u32, counters: &'a mut C) -> Self {
+        PacketJob { bvh, source, among, counters, kind: PhantomData }
+    }
+}
+
+impl<C: Counters> dispatch::PacketQuery for PacketJob<'_, C, Closest> {
     type Output = PacketBest;
 
     #[inline(always)]
@@ -450,15 +465,7 @@ impl<C: Counters> dispatch::PacketQuery for ClosestQuery<'_, C> {
     }
 }
 
-/// An any-hit packet query (see [`ClosestQuery`]): the rays that hit something.
-struct AnyQuery<'a, C> {
-    bvh: &'a TriangleBvh,
-    source: PacketSource<'a>,
-    among: u32,
-    counters: &'a mut C,
-}
-
-impl<C: Counters> dispatch::PacketQuery for AnyQuery<'_, C> {
+impl<C: Counters> dispatch::PacketQuery for PacketJob<'_, C, Any> {
     type Output = u32;
 
     #[inline(always)]
