@@ -380,12 +380,12 @@ impl TriangleBvh {
     /// preparation included) compiled for the structure's instruction set (see
     /// [`dispatch::packet_query`]).
     fn closest_query<C: Counters>(&self, source: PacketSource, among: u32, counters: &mut C) -> PacketBest {
-        dispatch::packet_query(self.isa(), PacketJob::<C, Closest>::new(self, source, among, counters))
+        dispatch::packet_query(self.isa(), PacketJob::<C, ClosestHits>::new(self, source, among, counters))
     }
 
     /// The valid rays of `among` in `source` that hit something (see [`TriangleBvh::closest_query`]).
     fn any_query<C: Counters>(&self, source: PacketSource, among: u32, counters: &mut C) -> u32 {
-        dispatch::packet_query(self.isa(), PacketJob::<C, Any>::new(self, source, among, counters))
+        dispatch::packet_query(self.isa(), PacketJob::<C, AnyHit>::new(self, source, among, counters))
     }
 
     /// The valid rays of `among` in `packet` that hit something.
@@ -435,7 +435,7 @@ impl PacketSource<'_> {
 }
 
 /// A packet query as [`dispatch::packet_query`] runs it: the rays prepared (checked, inverted,
-/// bounded), then walked for their closest hits ([`Closest`]) or for any hit ([`Any`]).
+/// bounded), then walked for their closest hits ([`ClosestHits`]) or for any hit ([`AnyHit`]).
 struct PacketJob<'a, C, K> {
     bvh: &'a TriangleBvh,
     source: PacketSource<'a>,
@@ -445,10 +445,10 @@ struct PacketJob<'a, C, K> {
 }
 
 /// A [`PacketJob`] for the closest hits.
-struct Closest;
+struct ClosestHits;
 
 /// A [`PacketJob`] for the rays that hit anything.
-struct Any;
+struct AnyHit;
 
 impl<'a, C, K> PacketJob<'a, C, K> {
     fn new(bvh: &'a TriangleBvh, source: PacketSource<'a>, among: u32, counters: &'a mut C) -> Self {
@@ -456,7 +456,7 @@ impl<'a, C, K> PacketJob<'a, C, K> {
     }
 }
 
-impl<C: Counters> dispatch::PacketQuery for PacketJob<'_, C, Closest> {
+impl<C: Counters> dispatch::PacketQuery for PacketJob<'_, C, ClosestHits> {
     type Output = PacketBest;
 
     #[inline(always)]
@@ -465,7 +465,7 @@ impl<C: Counters> dispatch::PacketQuery for PacketJob<'_, C, Closest> {
     }
 }
 
-impl<C: Counters> dispatch::PacketQuery for PacketJob<'_, C, Any> {
+impl<C: Counters> dispatch::PacketQuery for PacketJob<'_, C, AnyHit> {
     type Output = u32;
 
     #[inline(always)]
