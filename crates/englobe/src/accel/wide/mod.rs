@@ -60,6 +60,7 @@ pub mod ray_packet;
 pub mod refit;
 pub mod traverse;
 pub mod triangle_bvh;
+mod triangle_leaves;
 pub mod triangle_packet;
 pub mod triangles;
 pub mod validate;

@@ -61,6 +61,16 @@ pub trait Leaves<C: Counters> {
     fn t_max(&self) -> f32;
     /// Whether any of the `count` items from `first` is hit.
     fn any(&mut self, prepared: &Self::Prepared, first: u32, count: u32, counters: &mut C) -> bool;
+    /// Decides what [`Leaves::closest`] left undecided (see `triangle_leaves`): called once, when
+    /// the walk has ended. Nothing by default.
+    #[inline(always)]
+    fn settle_closest(&mut self) {}
+    /// Whether an item [`Leaves::any`] left undecided is hit: asked once, when the walk has ended
+    /// without a hit. None by default.
+    #[inline(always)]
+    fn settle_any(&mut self) -> bool {
+        false
+    }
     /// Starts loading the first item from `first` into the cache (a hint; nothing by default).
     #[inline(always)]
     fn prefetch(&self, first: u32) {
@@ -312,6 +322,7 @@ pub unsafe fn closest<K: NodeKernel, C: Counters, L: Leaves<C>>(
         }
     }
     give_back(deep);
+    leaves.settle_closest();
 }
 
 /// Whether any leaf item is hit, from node `start`: stops at the first one `leaves` reports.
@@ -384,5 +395,5 @@ pub unsafe fn any<K: NodeKernel, C: Counters, L: Leaves<C>>(
         }
     };
     give_back(deep);
-    hit
+    hit || leaves.settle_any()
 }

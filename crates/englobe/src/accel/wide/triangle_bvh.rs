@@ -15,12 +15,11 @@ use super::dispatch;
 use super::isa::{Isa, IsaUnavailable};
 use super::node::{NodeRay, WideNode, may_enter, reach};
 use super::presplit::{TriangleBox, presplit_cuts};
-use super::traverse::Leaves;
-use super::triangles::{LANES, TriBlock, TriRay, UNUSED, intersect_block, is_storable};
+use super::triangle_leaves;
+use super::triangles::{LANES, TriBlock, UNUSED, is_storable};
 use crate::accel::bvh::BinnedSah;
 use crate::accel::bvh::build::parallel::{collect_indexed, collect_indexed_huge, map_chunks};
 use crate::accel::{Counters, Hit, HitFilter, LEAF_SIZE_BUCKETS, MAX_PRIMITIVES, NoFilter, StructureStats};
-use crate::geom::prefetch::prefetch;
 use crate::shapes::{MeshError, TriangleMesh, check_arrays};
 use crate::{Aabb, Ray};
 
@@ -357,9 +356,10 @@ impl TriangleBvh {
         if !self.may_enter(ray) {
             return None;
         }
-        let mut leaves = TriangleLeaves { blocks: &self.blocks, source: ray, best: None, t_max: ray.t_max, filter };
-        dispatch::closest(self.isa, &self.nodes, self.depth, 0, &NodeRay::new(ray), &mut leaves, counters);
-        leaves.best
+        let node_ray = NodeRay::new(ray);
+        triangle_leaves::closest_hit(&self.blocks, ray, ray.t_max, filter, |leaves| {
+            dispatch::closest(self.isa, &self.nodes, self.depth, 0, &node_ray, leaves, counters)
+        })
     }
 
     /// [`TriangleBvh::any_hit`] counting only the hits `filter` accepts.
@@ -385,8 +385,10 @@ impl TriangleBvh {
         if !self.may_enter(ray) {
             return false;
         }
-        let mut leaves = TriangleLeaves { blocks: &self.blocks, source: ray, best: None, t_max: ray.t_max, filter };
-        dispatch::any(self.isa, &self.nodes, self.depth, 0, &NodeRay::new(ray), reach(ray.t_max), &mut leaves, counters)
+        let node_ray = NodeRay::new(ray);
+        triangle_leaves::any_hit(&self.blocks, ray, ray.t_max, filter, |leaves| {
+            dispatch::any(self.isa, &self.nodes, self.depth, 0, &node_ray, reach(ray.t_max), leaves, counters)
+        })
     }
 
     /// Whether `ray` may reach the tree: its origin inside the tree's box (then the root's test
@@ -428,126 +430,5 @@ impl TriangleBvh {
             sah_cost: None,
             leaf_sizes,
         }
-    }
-}
-
-/// A query's view of the triangle blocks, its closest hit so far, and the caller's filter.
-pub(super) struct TriangleLeaves<'a, F> {
-    pub(super) blocks: &'a [TriBlock],
-    pub(super) source: &'a Ray,
-    pub(super) best: Option<Hit>,
-    pub(super) t_max: f32,
-    pub(super) filter: F,
-}
-
-/// Keeps the hit on triangle `prim` in `best` if it is closer, or as close with a lower index
-/// (the rule of [`crate::accel::HitRecord::offer`]), and the filter accepts it; shrinks `t_max`
-/// to it.
-#[inline(always)]
-fn offer<F: HitFilter<Hit>>(best: &mut Option<Hit>, t_max: &mut f32, filter: &mut F, hit: Hit) {
-    let better = match *best {
-        None => true,
-        Some(b) => hit.t < b.t || (hit.t == b.t && hit.prim < b.prim),
-    };
-    if better && (F::ACCEPTS_ALL || filter.accept(&hit)) {
-        *best = Some(hit);
-        *t_max = hit.t;
-    }
-}
-
-impl<C: Counters, F: HitFilter<Hit>> Leaves<C> for TriangleLeaves<'_, F> {
-    /// The triangle test's constants of the ray.
-    type Prepared = TriRay;
-
-    #[inline(always)]
-    fn prepare(&self) -> TriRay {
-        TriRay::new(self.source)
-    }
-
-    #[inline(always)]
-    fn closest(&mut self, ray: &TriRay, first: u32, count: u32, counters: &mut C) {
-        let source = self.source;
-        for block in &self.blocks[first as usize..(first + count) as usize] {
-            for _ in 0..block.used() {
-                counters.exact_test();
-            }
-            let hits = intersect_block(block, ray, self.t_max);
-            if hits.hit | hits.special == 0 {
-                continue;
-            }
-            let mut mask = hits.hit;
-            while mask != 0 {
-                let lane = mask.trailing_zeros() as usize;
-                mask &= mask - 1;
-                if block.ids[lane] != UNUSED {
-                    let hit = Hit { t: hits.t[lane], prim: block.ids[lane], u: hits.u[lane], v: hits.v[lane] };
-                    offer(&mut self.best, &mut self.t_max, &mut self.filter, hit);
-                }
-            }
-            let mut mask = hits.special;
-            while mask != 0 {
-                let lane = mask.trailing_zeros() as usize;
-                mask &= mask - 1;
-                if block.ids[lane] != UNUSED
-                    && let Some(h) = TriRay::scalar(source, block, lane, self.t_max)
-                {
-                    let hit = Hit { t: h.t, prim: block.ids[lane], u: h.u, v: h.v };
-                    offer(&mut self.best, &mut self.t_max, &mut self.filter, hit);
-                }
-            }
-        }
-    }
-
-    #[inline(always)]
-    fn t_max(&self) -> f32 {
-        self.t_max
-    }
-
-    #[inline(always)]
-    fn prefetch(&self, first: u32) {
-        prefetch(self.blocks, first);
-    }
-
-    #[inline(always)]
-    fn any(&mut self, ray: &TriRay, first: u32, count: u32, counters: &mut C) -> bool {
-        let source = self.source;
-        for block in &self.blocks[first as usize..(first + count) as usize] {
-            for _ in 0..block.used() {
-                counters.exact_test();
-            }
-            let hits = intersect_block(block, ray, self.t_max);
-            if F::ACCEPTS_ALL {
-                // An unused lane repeats a used one: its hit is that lane's.
-                if hits.hit != 0 {
-                    return true;
-                }
-            } else {
-                let mut mask = hits.hit;
-                while mask != 0 {
-                    let lane = mask.trailing_zeros() as usize;
-                    mask &= mask - 1;
-                    let hit = Hit { t: hits.t[lane], prim: block.ids[lane], u: hits.u[lane], v: hits.v[lane] };
-                    if block.ids[lane] != UNUSED && self.filter.accept(&hit) {
-                        return true;
-                    }
-                }
-            }
-            let mut mask = hits.special;
-            while mask != 0 {
-                let lane = mask.trailing_zeros() as usize;
-                mask &= mask - 1;
-                if F::ACCEPTS_ALL {
-                    if TriRay::scalar(source, block, lane, self.t_max).is_some() {
-                        return true;
-                    }
-                } else if block.ids[lane] != UNUSED
-                    && let Some(h) = TriRay::scalar(source, block, lane, self.t_max)
-                    && self.filter.accept(&Hit { t: h.t, prim: block.ids[lane], u: h.u, v: h.v })
-                {
-                    return true;
-                }
-            }
-        }
-        false
     }
 }

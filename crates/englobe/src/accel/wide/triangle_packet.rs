@@ -17,7 +17,8 @@ use super::packet_triangles;
 use super::packet_triangles::{PacketBest, PacketTriRays};
 use super::ray_packet::{PacketHits, RayPacket};
 use super::traverse::Leaves;
-use super::triangle_bvh::{TriangleBvh, TriangleLeaves};
+use super::triangle_bvh::TriangleBvh;
+use super::triangle_leaves;
 use super::triangles::TriRay;
 use crate::accel::interface::batch::{run_batch_packets, run_packets};
 use crate::accel::{BatchSizeMismatch, Counters, Hit, NoCount, NoFilter};
@@ -60,17 +61,6 @@ impl<'a> TrianglePacket<'a> {
             self.simd = PacketTriRays::new(self.packet, self.active);
         }
         self.simd
-    }
-
-    /// Ray `i`'s single-ray leaf state (`source` being [`PacketRays::ray`]`(i)`), its interval
-    /// ending at its closest hit so far.
-    #[inline(always)]
-    fn lane<'r>(&self, source: &'r Ray, i: usize) -> TriangleLeaves<'r, NoFilter>
-    where
-        'a: 'r,
-    {
-        let blocks = self.bvh.blocks();
-        TriangleLeaves { blocks, source, best: None, t_max: self.best.t.0[i], filter: NoFilter }
     }
 
     /// Tests the blocks from `first` against the rays of `rays` a whole packet at a time; returns
@@ -137,10 +127,12 @@ impl<C: Counters> PacketLeaves<C> for TrianglePacket<'_> {
             let i = rays.trailing_zeros() as usize;
             rays &= rays - 1;
             let source = self.packet.ray(i);
-            let mut lane = self.lane(&source, i);
-            let ray = Leaves::<C>::prepare(&lane);
-            Leaves::<C>::closest(&mut lane, &ray, first, count, counters);
-            if let Some(hit) = lane.best {
+            let best = triangle_leaves::closest_hit(self.bvh.blocks(), &source, self.best.t.0[i], NoFilter, |lane| {
+                let ray = Leaves::<C>::prepare(lane);
+                Leaves::<C>::closest(lane, &ray, first, count, counters);
+                Leaves::<C>::settle_closest(lane);
+            });
+            if let Some(hit) = best {
                 self.best.offer(i, hit);
             }
             self.limits.0[i] = reach(self.best.t.0[i]);
@@ -158,9 +150,10 @@ impl<C: Counters> PacketLeaves<C> for TrianglePacket<'_> {
             let i = rays.trailing_zeros() as usize;
             rays &= rays - 1;
             let source = self.packet.ray(i);
-            let mut lane = self.lane(&source, i);
-            let ray = Leaves::<C>::prepare(&lane);
-            if Leaves::<C>::any(&mut lane, &ray, first, count, counters) {
+            if triangle_leaves::any_hit(self.bvh.blocks(), &source, self.best.t.0[i], NoFilter, |lane| {
+                let ray = Leaves::<C>::prepare(lane);
+                Leaves::<C>::any(lane, &ray, first, count, counters) || Leaves::<C>::settle_any(lane)
+            }) {
                 found |= 1 << i;
             }
         }
@@ -186,17 +179,20 @@ impl<C: Counters> PacketLeaves<C> for TrianglePacket<'_> {
             rays &= rays - 1;
             let source = &self.packet.ray(i);
             let node_ray = NodeRay::new(source);
-            let mut lane = self.lane(source, i);
+            let (blocks, t_max) = (bvh.blocks(), self.best.t.0[i]);
             if closest {
-                dispatch::closest(bvh.isa(), bvh.nodes(), bvh.depth(), reference, &node_ray, &mut lane, counters);
-                if let Some(hit) = lane.best {
+                let best = triangle_leaves::closest_hit(blocks, source, t_max, NoFilter, |lane| {
+                    dispatch::closest(bvh.isa(), bvh.nodes(), bvh.depth(), reference, &node_ray, lane, counters)
+                });
+                if let Some(hit) = best {
                     self.best.offer(i, hit);
                 }
                 self.limits.0[i] = reach(self.best.t.0[i]);
             } else {
                 let limit = reach(source.t_max);
-                if dispatch::any(bvh.isa(), bvh.nodes(), bvh.depth(), reference, &node_ray, limit, &mut lane, counters)
-                {
+                if triangle_leaves::any_hit(blocks, source, t_max, NoFilter, |lane| {
+                    dispatch::any(bvh.isa(), bvh.nodes(), bvh.depth(), reference, &node_ray, limit, lane, counters)
+                }) {
                     found |= 1 << i;
                 }
             }
