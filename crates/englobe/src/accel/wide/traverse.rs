@@ -208,11 +208,15 @@ pub unsafe fn closest<K: NodeKernel, C: Counters, L: Leaves<C>>(
     let mut dist = [0.0f32; WIDTH];
     let mut current = Entry { reference: start, count: 0, t: 0.0 };
     let mut prepared_slot = None;
+    // How far a box may begin and still be entered: kept here, where it stays in a register,
+    // and made again only when a leaf may have moved the closest hit.
+    let mut limit = reach(leaves.t_max());
     'walk: loop {
         {
             if is_leaf(current.reference) {
                 let prepared = prepare_once(&mut prepared_slot, leaves);
                 leaves.closest(prepared, index_of(current.reference), current.count, counters);
+                limit = reach(leaves.t_max());
             } else {
                 debug_assert!((current.reference as usize) < nodes.len());
                 // SAFETY: the caller's guarantee: interior references index `nodes`.
@@ -220,7 +224,7 @@ pub unsafe fn closest<K: NodeKernel, C: Counters, L: Leaves<C>>(
                 counters.node_visited();
                 counters.box_tests(WIDTH as u32);
                 // SAFETY: the caller's guarantee.
-                let mut mask = unsafe { kernel.children(node, ray, reach(leaves.t_max()), &mut dist) };
+                let mut mask = unsafe { kernel.children(node, ray, limit, &mut dist) };
                 if mask != 0 {
                     let first = take_lowest(&mut mask);
                     if mask == 0 {
@@ -314,7 +318,7 @@ pub unsafe fn closest<K: NodeKernel, C: Counters, L: Leaves<C>>(
                 len -= 1;
                 // SAFETY: entries below `len` were written.
                 let e = unsafe { stack[len].assume_init() };
-                if e.t <= reach(leaves.t_max()) {
+                if e.t <= limit {
                     current = e;
                     break;
                 }
