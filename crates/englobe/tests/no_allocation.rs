@@ -1,11 +1,13 @@
 //! Queries of the wide BVHs allocate nothing: a counting global allocator watches thousands of
 //! closest-hit and any-hit queries (with counting off, the zero-sized `NoCount`, and on). Trees
-//! deeper than the inline stack grow a per-thread buffer on their first query, and never again.
+//! deeper than the inline stack grow a per-thread buffer on their first query, and never again;
+//! so do the triangle queries that meet more lanes the SIMD test leaves undecided than their
+//! inline list holds.
 //! One test per binary, so that no other test's allocations are counted.
 
 use englobe::accel::bvh::layout::{BuildKind, BuildNode, BuildTree};
 use englobe::accel::wide::traverse::INLINE_DEPTH;
-use englobe::{Aabb, Accel, NoCount, PrimHit, Ray, TriangleBvh, Vec3, WideBvh, WorkCounts};
+use englobe::{Aabb, Accel, Hit, NoCount, PrimHit, Ray, TriangleBvh, Vec3, WideBvh, WorkCounts};
 
 #[path = "common/counting_alloc.rs"]
 mod counting_alloc;
@@ -77,4 +79,29 @@ fn queries_never_allocate() {
         }
     });
     assert_eq!(allocated, 0, "{allocated} allocations on a tree of depth {}", deep.depth());
+
+    // Forty triangles around a vertex that the rays go through: every lane undecided, more than
+    // the inline list holds, so the queries walk twice with the thread's longer list.
+    let fan: Vec<[Vec3; 3]> = (0..40)
+        .map(|k| {
+            let at = |i: usize| {
+                let a = i as f32 * std::f32::consts::TAU / 40.0;
+                Vec3::new(a.cos(), a.sin(), 0.0)
+            };
+            [Vec3::ZERO, at(k), at(k + 1)]
+        })
+        .collect();
+    let fan_bvh = TriangleBvh::from_triangles(&fan);
+    // (A filter that refuses every hit keeps the any-hit query from stopping at the first list.)
+    let down = Ray::new(Vec3::new(0.0, 0.0, 1.0), -Vec3::Z);
+    let refuse = |_: &Hit| false;
+    assert!(fan_bvh.closest_hit(&down, &mut NoCount).is_some());
+    assert!(!fan_bvh.any_hit_filtered(&down, &mut NoCount, refuse));
+    let allocated = allocations_during(|| {
+        for _ in 0..100 {
+            assert!(fan_bvh.closest_hit(&down, &mut NoCount).is_some());
+            assert!(!fan_bvh.any_hit_filtered(&down, &mut NoCount, refuse));
+        }
+    });
+    assert_eq!(allocated, 0, "{allocated} allocations through a shared vertex");
 }

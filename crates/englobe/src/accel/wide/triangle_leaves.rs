@@ -12,13 +12,17 @@
 //! A query that meets more than its list holds walks again ([`closest_hit`], [`any_hit`]), from
 //! where the first walk left its interval, with a list as long as the number it met: the second
 //! walk meets no more of them, since it visits a part of what the first visited (its interval is
-//! never longer) and whether a lane is decided does not depend on the interval.
+//! never longer) and whether a lane is decided does not depend on the interval. That list is kept
+//! per thread and grown once, as the deep trees' stack is (see [`super::traverse`]): no query
+//! allocates in the steady state.
 //!
 //! The answers are those of deciding each lane when it is met. A closest-hit walk that has not
 //! decided a lane keeps a longer interval, so it visits every node it would have visited, and
 //! perhaps more; those it would have skipped, the ray enters beyond the lane's hit, and every hit
 //! in them lies beyond it too (a hit lies in its triangle's box, see [`super::triangles`]): none is
 //! closer. An any-hit walk that meets a hit it can decide needs no other.
+
+use std::cell::Cell;
 
 use super::traverse::Leaves;
 use super::triangles::{TriBlock, TriRay, UNUSED, intersect_block};
@@ -31,6 +35,23 @@ pub const DEFERRED: usize = 8;
 
 /// An undecided lane: its block's index and the lane.
 type Noted = (u32, u8);
+
+thread_local! {
+    /// The list of the second walks, reused from query to query. A query nested inside another's
+    /// filter finds it taken and uses a fresh one.
+    static LONG_LIST: Cell<Vec<Noted>> = const { Cell::new(Vec::new()) };
+}
+
+/// `f` of a list of `len` entries: the thread's list, grown if need be, then handed back.
+fn with_long_list<R>(len: usize, f: impl FnOnce(&mut [Noted]) -> R) -> R {
+    let mut list = LONG_LIST.with(Cell::take);
+    if list.len() < len {
+        list.resize(len, (0, 0));
+    }
+    let answer = f(&mut list[..len]);
+    LONG_LIST.with(|kept| kept.set(list));
+    answer
+}
 
 /// A query's view of the triangle blocks, its closest hit so far, the caller's filter, and the
 /// lanes it has not decided yet.
@@ -65,12 +86,13 @@ pub(super) fn closest_hit<F: HitFilter<Hit>>(
         return leaves.best;
     }
     let TriangleLeaves { best, t_max, filter, met, .. } = leaves;
-    let mut list = vec![(0, 0); met];
-    let mut leaves = TriangleLeaves::new(blocks, source, t_max, filter, &mut list);
-    leaves.best = best;
-    walk(&mut leaves);
-    debug_assert!(leaves.met <= met);
-    leaves.best
+    with_long_list(met, |list| {
+        let mut leaves = TriangleLeaves::new(blocks, source, t_max, filter, list);
+        leaves.best = best;
+        walk(&mut leaves);
+        debug_assert!(leaves.met <= met);
+        leaves.best
+    })
 }
 
 /// Whether `source` hits one of `blocks` within `source.t_min..=t_max`, the hit accepted by
@@ -92,8 +114,7 @@ pub(super) fn any_hit<F: HitFilter<Hit>>(
         return false;
     }
     let TriangleLeaves { filter, met, .. } = leaves;
-    let mut list = vec![(0, 0); met];
-    walk(&mut TriangleLeaves::new(blocks, source, t_max, filter, &mut list))
+    with_long_list(met, |list| walk(&mut TriangleLeaves::new(blocks, source, t_max, filter, list)))
 }
 
 impl<'a, F: HitFilter<Hit>> TriangleLeaves<'a, F> {
