@@ -37,20 +37,9 @@ pub const DEFERRED: usize = 8;
 type Noted = (u32, u8);
 
 thread_local! {
-    /// The list of the second walks, reused from query to query. A query nested inside another's
-    /// filter finds it taken and uses a fresh one.
+    /// The list of the walks after a first one that met too many undecided lanes, reused from
+    /// query to query. A query nested inside another's filter finds it taken and uses a fresh one.
     static LONG_LIST: Cell<Vec<Noted>> = const { Cell::new(Vec::new()) };
-}
-
-/// `f` of a list of `len` entries: the thread's list, grown if need be, then handed back.
-fn with_long_list<R>(len: usize, f: impl FnOnce(&mut [Noted]) -> R) -> R {
-    let mut list = LONG_LIST.with(Cell::take);
-    if list.len() < len {
-        list.resize(len, (0, 0));
-    }
-    let answer = f(&mut list[..len]);
-    LONG_LIST.with(|kept| kept.set(list));
-    answer
 }
 
 /// A query's view of the triangle blocks, its closest hit so far, the caller's filter, and the
@@ -86,13 +75,38 @@ pub(super) fn closest_hit<F: HitFilter<Hit>>(
         return leaves.best;
     }
     let TriangleLeaves { best, t_max, filter, met, .. } = leaves;
-    with_long_list(met, |list| {
-        let mut leaves = TriangleLeaves::new(blocks, source, t_max, filter, list);
+    closest_hit_again(blocks, source, (best, t_max, filter), met, &mut walk)
+}
+
+/// The walks that follow one that met `met` undecided lanes, more than its list held, from where
+/// it left the closest hit, the interval and the filter: each with a list as long as the number
+/// the walk before met, on the thread's long list. A second walk never meets more (see the module
+/// documentation); the loop would go on if it did.
+#[cold]
+#[inline(never)]
+fn closest_hit_again<F: HitFilter<Hit>>(
+    blocks: &[TriBlock],
+    source: &Ray,
+    (mut best, mut t_max, mut filter): (Option<Hit>, f32, F),
+    mut met: usize,
+    walk: &mut impl FnMut(&mut TriangleLeaves<'_, F>),
+) -> Option<Hit> {
+    let mut list = LONG_LIST.with(Cell::take);
+    loop {
+        if list.len() < met {
+            list.resize(met, (0, 0));
+        }
+        let mut leaves = TriangleLeaves::new(blocks, source, t_max, filter, &mut list[..met]);
         leaves.best = best;
         walk(&mut leaves);
-        debug_assert!(leaves.met <= met);
-        leaves.best
-    })
+        let room = met;
+        (best, t_max, filter, met) = (leaves.best, leaves.t_max, leaves.filter, leaves.met);
+        if met <= room {
+            break;
+        }
+    }
+    LONG_LIST.with(|kept| kept.set(list));
+    best
 }
 
 /// Whether `source` hits one of `blocks` within `source.t_min..=t_max`, the hit accepted by
@@ -114,7 +128,38 @@ pub(super) fn any_hit<F: HitFilter<Hit>>(
         return false;
     }
     let TriangleLeaves { filter, met, .. } = leaves;
-    with_long_list(met, |list| walk(&mut TriangleLeaves::new(blocks, source, t_max, filter, list)))
+    any_hit_again(blocks, source, t_max, filter, met, &mut walk)
+}
+
+/// The walks that follow an any-hit walk that found no hit and met `met` undecided lanes, more
+/// than its list held: as in [`closest_hit_again`].
+#[cold]
+#[inline(never)]
+fn any_hit_again<F: HitFilter<Hit>>(
+    blocks: &[TriBlock],
+    source: &Ray,
+    t_max: f32,
+    mut filter: F,
+    mut met: usize,
+    walk: &mut impl FnMut(&mut TriangleLeaves<'_, F>) -> bool,
+) -> bool {
+    let mut list = LONG_LIST.with(Cell::take);
+    let hit = loop {
+        if list.len() < met {
+            list.resize(met, (0, 0));
+        }
+        let mut leaves = TriangleLeaves::new(blocks, source, t_max, filter, &mut list[..met]);
+        if walk(&mut leaves) {
+            break true;
+        }
+        let room = met;
+        (filter, met) = (leaves.filter, leaves.met);
+        if met <= room {
+            break false;
+        }
+    };
+    LONG_LIST.with(|kept| kept.set(list));
+    hit
 }
 
 impl<'a, F: HitFilter<Hit>> TriangleLeaves<'a, F> {
