@@ -2,7 +2,8 @@
 //! (Woop, Benthin and Wald 2013): the same closest hit (triangle, `t`, barycentrics, bit for bit)
 //! and the same any-hit answer, in every instruction set the processor has, with counting on and
 //! off, one ray at a time and in packets. Random soups with degenerate triangles, axis-parallel rays through shared vertices and
-//! edges, ties between copies, deep trees, and the Stanford bunny.
+//! edges, vertices shared by up to forty triangles, ties between copies, deep trees, and the
+//! Stanford bunny.
 
 mod common;
 
@@ -140,6 +141,40 @@ fn axis_parallel_rays_through_shared_vertices_and_edges() {
     // Watertight: every vertical ray inside the grid's footprint hits.
     let vertical = rays.iter().filter(|r| r.dir().x == 0.0 && r.dir().y == 0.0).count();
     assert!(hits >= vertical, "{hits} hits, {vertical} vertical rays");
+}
+
+#[test]
+fn vertices_shared_by_many_triangles() {
+    // Fans of 6 to 40 triangles around vertices at several heights, one above another: a ray
+    // through the shared vertices leaves every lane of their blocks to the scalar test, more lanes
+    // than a query notes in its first walk, so the walks that follow it decide them. Rays down
+    // through the vertices (whole line and short segments that stop before some fans, for any-hit
+    // queries that find nothing), slanted rays aimed at them, and rays beside them.
+    let mut tris = Vec::new();
+    for (f, n) in [6, 12, 40, 23, 9].into_iter().enumerate() {
+        let centre = Vec3::new(0.25 * f as f32, 0.0, -(f as f32));
+        for k in 0..n {
+            let at = |i: usize| {
+                let a = i as f32 * std::f32::consts::TAU / n as f32;
+                centre + Vec3::new(a.cos(), a.sin(), 0.1 * (i % 3) as f32)
+            };
+            tris.push([centre, at(k), at(k + 1)]);
+        }
+    }
+    let mut rays = Vec::new();
+    for f in 0..5 {
+        let centre = Vec3::new(0.25 * f as f32, 0.0, -(f as f32));
+        for t_max in [f32::INFINITY, 0.5, 1.5] {
+            rays.push(Ray::segment(centre + Vec3::Z, -Vec3::Z, 0.0, t_max));
+        }
+        for o in [Vec3::new(2.0, 1.0, 3.0), Vec3::new(-1.5, -2.0, 1.0), Vec3::new(0.5, 3.0, -7.0)] {
+            rays.push(Ray::new(o, centre - o));
+            rays.push(Ray::segment(o, centre - o, 0.0, 0.999));
+            rays.push(Ray::new(o, centre + Vec3::new(0.01, 0.02, 0.0) - o));
+        }
+    }
+    let hits = check(&tris, &rays).unwrap();
+    assert!(hits > rays.len() / 2, "{hits} of {} rays hit", rays.len());
 }
 
 #[test]
