@@ -25,7 +25,7 @@
 use std::cell::Cell;
 
 use super::traverse::Leaves;
-use super::triangles::{TriBlock, TriRay, UNUSED, intersect_block};
+use super::triangles::{BlockHits, TriBlock, TriRay, UNUSED, intersect_block};
 use crate::Ray;
 use crate::accel::{Counters, Hit, HitFilter};
 use crate::geom::prefetch::prefetch;
@@ -51,9 +51,8 @@ pub(super) struct TriangleLeaves<'a, F> {
     best: Option<Hit>,
     t_max: f32,
     filter: F,
-    /// The list of undecided lanes, its first `noted` entries used.
+    /// The list of undecided lanes, its first `min(met, list.len())` entries used.
     list: &'a mut [Noted],
-    noted: usize,
     /// The undecided lanes met, noted or not.
     met: usize,
 }
@@ -167,7 +166,22 @@ impl<'a, F: HitFilter<Hit>> TriangleLeaves<'a, F> {
     /// lanes in `list`.
     #[inline(always)]
     fn new(blocks: &'a [TriBlock], source: &'a Ray, t_max: f32, filter: F, list: &'a mut [Noted]) -> Self {
-        TriangleLeaves { blocks, source, best: None, t_max, filter, list, noted: 0, met: 0 }
+        TriangleLeaves { blocks, source, best: None, t_max, filter, list, met: 0 }
+    }
+
+    /// The undecided lanes the list holds.
+    #[inline(always)]
+    fn noted(&self) -> usize {
+        self.met.min(self.list.len())
+    }
+
+    /// `block` tested (its used lanes counted as exact tests) within the interval.
+    #[inline(always)]
+    fn test<C: Counters>(&self, block: &TriBlock, ray: &TriRay, counters: &mut C) -> BlockHits {
+        for _ in 0..block.used() {
+            counters.exact_test();
+        }
+        intersect_block(block, ray, self.t_max)
     }
 
     /// Notes the undecided lanes `special` of the block at `index`, as far as the list holds them.
@@ -181,9 +195,8 @@ impl<'a, F: HitFilter<Hit>> TriangleLeaves<'a, F> {
             if block.ids[lane] == UNUSED {
                 continue;
             }
-            if let Some(slot) = self.list.get_mut(self.noted) {
+            if let Some(slot) = self.list.get_mut(self.met) {
                 *slot = (index as u32, lane as u8);
-                self.noted += 1;
             }
             self.met += 1;
         }
@@ -206,7 +219,7 @@ impl<'a, F: HitFilter<Hit>> TriangleLeaves<'a, F> {
     #[cold]
     #[inline(never)]
     fn decide_closest(&mut self) {
-        for i in 0..self.noted {
+        for i in 0..self.noted() {
             if let Some(hit) = self.scalar_hit(self.list[i]) {
                 offer(&mut self.best, &mut self.t_max, &mut self.filter, hit);
             }
@@ -217,7 +230,7 @@ impl<'a, F: HitFilter<Hit>> TriangleLeaves<'a, F> {
     #[cold]
     #[inline(never)]
     fn decide_any(&mut self) -> bool {
-        for i in 0..self.noted {
+        for i in 0..self.noted() {
             if let Some(hit) = self.scalar_hit(self.list[i])
                 && (F::ACCEPTS_ALL || self.filter.accept(&hit))
             {
@@ -257,10 +270,7 @@ impl<C: Counters, F: HitFilter<Hit>> Leaves<C> for TriangleLeaves<'_, F> {
         let blocks = self.blocks;
         let first = first as usize;
         for (i, block) in blocks[first..first + count as usize].iter().enumerate() {
-            for _ in 0..block.used() {
-                counters.exact_test();
-            }
-            let hits = intersect_block(block, ray, self.t_max);
+            let hits = self.test(block, ray, counters);
             if hits.hit | hits.special == 0 {
                 continue;
             }
@@ -281,7 +291,7 @@ impl<C: Counters, F: HitFilter<Hit>> Leaves<C> for TriangleLeaves<'_, F> {
 
     #[inline(always)]
     fn settle_closest(&mut self) {
-        if self.noted != 0 {
+        if self.met != 0 {
             self.decide_closest();
         }
     }
@@ -301,10 +311,7 @@ impl<C: Counters, F: HitFilter<Hit>> Leaves<C> for TriangleLeaves<'_, F> {
         let blocks = self.blocks;
         let first = first as usize;
         for (i, block) in blocks[first..first + count as usize].iter().enumerate() {
-            for _ in 0..block.used() {
-                counters.exact_test();
-            }
-            let hits = intersect_block(block, ray, self.t_max);
+            let hits = self.test(block, ray, counters);
             if F::ACCEPTS_ALL {
                 // An unused lane repeats a used one: its hit is that lane's.
                 if hits.hit != 0 {
@@ -330,7 +337,7 @@ impl<C: Counters, F: HitFilter<Hit>> Leaves<C> for TriangleLeaves<'_, F> {
 
     #[inline(always)]
     fn settle_any(&mut self) -> bool {
-        self.noted != 0 && self.decide_any()
+        self.met != 0 && self.decide_any()
     }
 }
 
