@@ -2,12 +2,13 @@
 //! closest-hit and any-hit queries (with counting off, the zero-sized `NoCount`, and on). Trees
 //! deeper than the inline stack grow a per-thread buffer on their first query, and never again;
 //! so do the triangle queries that meet more lanes the SIMD test leaves undecided than their
-//! inline list holds.
+//! inline list holds. Packet queries too, those whose rays are asked again alone included.
 //! One test per binary, so that no other test's allocations are counted.
 
 use englobe::accel::bvh::layout::{BuildKind, BuildNode, BuildTree};
+use englobe::accel::wide::packet_kernels::PACKET;
 use englobe::accel::wide::traverse::INLINE_DEPTH;
-use englobe::{Aabb, Accel, Hit, NoCount, PrimHit, Ray, TriangleBvh, Vec3, WideBvh, WorkCounts};
+use englobe::{Aabb, Accel, Hit, NoCount, PrimHit, Ray, RayPacket, TriangleBvh, Vec3, WideBvh, WorkCounts};
 
 #[path = "common/counting_alloc.rs"]
 mod counting_alloc;
@@ -104,4 +105,39 @@ fn queries_never_allocate() {
         }
     });
     assert_eq!(allocated, 0, "{allocated} allocations through a shared vertex");
+
+    // Packets: the rays above in rows of sixteen; sixteen rays through the fan's vertex (more
+    // undecided pairs than a packet notes: each ray asked again alone); and a packet whose rays
+    // do not share the watertight test's axes (asked again ray by ray with AVX-512).
+    let rows: Vec<RayPacket> = rays
+        .chunks(PACKET)
+        .map(|chunk| {
+            let mut rows = RayPacket::default();
+            for (lane, r) in chunk.iter().enumerate() {
+                rows.set(lane, r.origin(), r.dir(), r.t_min, r.t_max);
+            }
+            rows
+        })
+        .collect();
+    let (mut through_vertex, mut mixed) = (RayPacket::default(), RayPacket::default());
+    for lane in 0..PACKET {
+        let origin = Vec3::new(0.01 * lane as f32, 0.0, 1.0);
+        through_vertex.set(lane, origin, -origin, 0.0, f32::INFINITY);
+        let d = if lane % 2 == 0 { Vec3::new(0.3, 0.2, -1.0) } else { Vec3::new(1.0, 0.2, -0.3) };
+        mixed.set(lane, Vec3::new(30.0, 30.0, 10.0), d, 0.0, f32::INFINITY);
+    }
+    let all = u32::MAX >> (32 - PACKET);
+    let mut hits = 0;
+    let allocated = allocations_during(|| {
+        for _ in 0..10 {
+            for p in rows.iter().chain([&mixed]) {
+                hits += tri_bvh.closest_hit_ray_packet(p, all, &mut NoCount).mask().count_ones();
+                hits += tri_bvh.any_hit_ray_packet(p, all, &mut WorkCounts::default()).count_ones();
+            }
+            assert_eq!(fan_bvh.closest_hit_ray_packet(&through_vertex, all, &mut NoCount).mask(), all);
+            assert_eq!(fan_bvh.any_hit_ray_packet(&through_vertex, all, &mut NoCount), all);
+        }
+    });
+    assert_eq!(allocated, 0, "{allocated} allocations in packet queries");
+    assert!(hits as usize > rays.len(), "{hits}");
 }

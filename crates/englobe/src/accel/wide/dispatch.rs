@@ -116,6 +116,45 @@ pub fn any_packet<C: Counters, L: PacketLeaves<C>>(
     }
 }
 
+/// The packet closest-hit traversal compiled for AVX-512, for leaves whose tests are compiled
+/// into it with those features (see [`super::packet_triangles::block_avx512`]).
+///
+/// # Safety
+/// The processor has AVX-512 F, VL, BW and DQ ([`Isa::Avx512`] is available), and `depth`
+/// [`packet::fits`].
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+pub unsafe fn closest_packet_avx512<C: Counters, L: PacketLeaves<C>>(
+    nodes: &[WideNode],
+    rays: &PacketRays,
+    active: u32,
+    leaves: &mut L,
+    counters: &mut C,
+) {
+    debug_assert!(Isa::Avx512.is_available());
+    // SAFETY: the caller's guarantee.
+    unsafe { x86::closest_packet_avx512(nodes, rays, active, leaves, counters) }
+}
+
+/// The packet any-hit traversal compiled for AVX-512 (see [`closest_packet_avx512`]): the rays
+/// that hit.
+///
+/// # Safety
+/// As [`closest_packet_avx512`].
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+pub unsafe fn any_packet_avx512<C: Counters, L: PacketLeaves<C>>(
+    nodes: &[WideNode],
+    rays: &PacketRays,
+    active: u32,
+    leaves: &mut L,
+    counters: &mut C,
+) -> u32 {
+    debug_assert!(Isa::Avx512.is_available());
+    // SAFETY: the caller's guarantee.
+    unsafe { x86::any_packet_avx512(nodes, rays, active, leaves, counters) }
+}
+
 /// A whole packet query, from the rays as the caller hands them over to the answers: compiled by
 /// [`packet_query`] with the structure's instruction set, so that the rays' preparation (the
 /// inverse directions, the checks, the packet's bounds) runs with the same vector instructions as

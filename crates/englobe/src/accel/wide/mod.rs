@@ -27,9 +27,10 @@
 //!   [`packet_interval`], the test that culls a node's children for a whole packet at once, and
 //!   [`packet_triangles`], the triangle test of a whole packet.
 //! * [`triangles`]: blocks of four triangles and their SIMD watertight test; [`triangle_bvh`]:
-//!   [`TriangleBvh`]; [`triangle_packet`]: its packet queries and batches, with [`ray_packet`],
-//!   the rays and hits of a packet as rows that programs fill and read; [`presplit`]: the
-//!   large triangles cut before its build.
+//!   [`TriangleBvh`], with `triangle_leaves` (inside the crate): a ray's leaf tests;
+//!   [`triangle_packet`]: its packet queries and batches, with `triangle_packet_leaves` (inside
+//!   the crate): a packet's leaf tests, and [`ray_packet`], the rays and hits of a packet as rows
+//!   that programs fill and read; [`presplit`]: the large triangles cut before its build.
 //! * [`point_query`]: the closest point of the triangles to a point; [`box_query`]: the
 //!   triangles overlapping a box.
 //! * [`refit`]: the boxes recomputed after the triangles moved, and the SAH cost that says when
@@ -62,6 +63,7 @@ pub mod traverse;
 pub mod triangle_bvh;
 mod triangle_leaves;
 pub mod triangle_packet;
+mod triangle_packet_leaves;
 pub mod triangles;
 pub mod validate;
 

@@ -3,7 +3,8 @@
 //! broadcast, as Embree's hybrid traversal tests its `Triangle4` leaves against ray packets (Wald
 //! et al. 2014). The test shears each ray's frame by its own axes; a packet whose rays share the
 //! axes (the camera rays of a tile, nearly always) reads the same rows of the block for every
-//! lane, so only those packets take this path. The others test one ray at a time.
+//! lane, so only those packets take this path. The others are asked again one ray at a time
+//! (see `triangle_packet_leaves`).
 //!
 //! Each lane computes exactly what a lane of the single-ray block test
 //! ([`super::triangles::intersect_block`]) computes for its ray and triangle: the same operations
@@ -29,25 +30,46 @@ pub struct PacketTriRays {
 }
 
 impl PacketTriRays {
-    /// Prepares the rays of `active` (bit per ray of `packet`, at least one), or `None` if they
-    /// do not all share the watertight test's axes.
+    /// The watertight test's axes `[kx, ky, kz]` of the rays of `active` (bit per ray of
+    /// `packet`, at least one), or `None` if they do not all share them.
     #[inline(always)]
-    pub fn new(packet: &PacketRays, active: u32) -> Option<Self> {
+    pub fn shared_axes(packet: &PacketRays, active: u32) -> Option<[usize; 3]> {
         if active == 0 {
             return None;
         }
-        let dir = |i: usize| Vec3::new(packet.dir[0].0[i], packet.dir[1].0[i], packet.dir[2].0[i]);
-        let axes = WatertightRay::axes_of(dir(active.trailing_zeros() as usize));
-        let mut rest = active;
-        while rest != 0 {
-            let i = rest.trailing_zeros() as usize;
-            rest &= rest - 1;
-            // Compared as one small integer: comparing the arrays made the compiler store them
-            // and load them back as a vector, a stall per ray.
-            if packed(WatertightRay::axes_of(dir(i))) != packed(axes) {
-                return None;
-            }
+        // Each lane's axes, as `WatertightRay::axes_of` chooses them, in one small integer (the
+        // axis of the largest component and whether the ray goes down it): every lane at once in
+        // one vector loop, since this runs for every packet before its walk.
+        let [dx, dy, dz] = [&packet.dir[0].0, &packet.dir[1].0, &packet.dir[2].0];
+        let mut code = [0u32; PACKET];
+        for i in 0..PACKET {
+            let (ax, ay, az) = (dx[i].abs(), dy[i].abs(), dz[i].abs());
+            let x_largest = (ax >= ay) & (ax >= az);
+            let y_largest = !x_largest & (ay >= az);
+            let d = if x_largest {
+                dx[i]
+            } else if y_largest {
+                dy[i]
+            } else {
+                dz[i]
+            };
+            code[i] = 2 * (!x_largest as u32 + !(x_largest | y_largest) as u32) + (d < 0.0) as u32;
         }
+        let first = active.trailing_zeros() as usize;
+        let mut differ = 0u32;
+        for (i, &c) in code.iter().enumerate() {
+            differ |= ((c != code[first]) as u32) << i;
+        }
+        if differ & active != 0 {
+            return None;
+        }
+        Some(WatertightRay::axes_of(Vec3::new(dx[first], dy[first], dz[first])))
+    }
+
+    /// Prepares the rays of `active` (bit per ray of `packet`), which share the axes `axes`
+    /// ([`PacketTriRays::shared_axes`]).
+    #[inline(always)]
+    pub fn new(packet: &PacketRays, active: u32, axes: [usize; 3]) -> Self {
         // The rows of the shared axes, whole: the lanes left out are never read but for the
         // divisions below, where 1 along `kz` keeps them finite.
         let mut p = PacketTriRays { origin_k: axes.map(|a| packet.origin[a]), shear: [Lanes([0.0; PACKET]); 3], axes };
@@ -63,14 +85,8 @@ impl PacketTriRays {
             p.shear[1].0[i] = dy[i] / dz[i];
             p.shear[2].0[i] = 1.0 / dz[i];
         }
-        Some(p)
+        p
     }
-}
-
-/// Axes `[kx, ky, kz]` (each below 3) as one integer.
-#[inline(always)]
-fn packed(axes: [usize; 3]) -> usize {
-    axes[0] | axes[1] << 2 | axes[2] << 4
 }
 
 /// The closest hit of each ray of a packet so far, as a structure of arrays. A ray without a hit
@@ -134,9 +150,14 @@ mod x86 {
     /// without, only reports hits within `best.t`. Returns
     /// the rays that hit, and the pairs the scalar test must decide (bit `16 * lane + ray`).
     ///
+    /// Compiled into its caller (`#[inline(always)]`, without features of its own), so that a
+    /// packet walk compiled with AVX-512 keeps its registers across it: a call in the walk's loop
+    /// would have the caller save every vector register.
+    ///
     /// # Safety
-    /// The processor has AVX-512 F (and the features enabled here).
-    #[target_feature(enable = "avx2,fma,bmi1,bmi2,lzcnt,popcnt,avx512f,avx512vl,avx512bw,avx512dq")]
+    /// The processor has AVX-512 F, VL, BW and DQ. The caller should be compiled with them, or
+    /// every intrinsic below becomes a call.
+    #[inline(always)]
     pub unsafe fn block_avx512(
         block: &TriBlock,
         packet: &PacketRays,
@@ -145,102 +166,110 @@ mod x86 {
         best: &mut PacketBest,
         closest: bool,
     ) -> (u32, u64) {
-        let rays = rays as __mmask16;
-        // SAFETY: every `Lanes` is 64 bytes aligned to 64.
-        let load = |l: &super::Lanes| unsafe { _mm512_load_ps(l.0.as_ptr()) };
-        let [kx, ky, kz] = r.axes;
-        let o_k = [load(&r.origin_k[0]), load(&r.origin_k[1]), load(&r.origin_k[2])];
-        let (sx, sy, sz) = (load(&r.shear[0]), load(&r.shear[1]), load(&r.shear[2]));
-        let zero = _mm512_setzero_ps();
-        let abs = |x: __m512| _mm512_abs_ps(x);
-        let normal = |x: __m512| {
-            _mm512_cmp_ps_mask::<_CMP_GE_OQ>(abs(x), _mm512_set1_ps(f32::MIN_POSITIVE))
-                & _mm512_cmp_ps_mask::<_CMP_LT_OQ>(abs(x), _mm512_set1_ps(f32::INFINITY))
-        };
-        let (mut hit_rays, mut special_pairs) = (0u16, 0u64);
-        for lane in 0..LANES {
-            let id = block.ids[lane];
-            if id == UNUSED {
-                continue;
-            }
-            let at = |k: usize, axis: usize| block.v[3 * k + axis][lane];
-            // Vertex k relative to the origin, sheared: the block test's `ax`, `ay`, `az`.
-            let project = |k: usize| {
-                let x = _mm512_sub_ps(_mm512_set1_ps(at(k, kx)), o_k[0]);
-                let y = _mm512_sub_ps(_mm512_set1_ps(at(k, ky)), o_k[1]);
-                let z = _mm512_sub_ps(_mm512_set1_ps(at(k, kz)), o_k[2]);
-                (_mm512_sub_ps(x, _mm512_mul_ps(sx, z)), _mm512_sub_ps(y, _mm512_mul_ps(sy, z)), z)
+        // SAFETY: the caller's guarantee: the processor has the features of every intrinsic.
+        unsafe {
+            let rays = rays as __mmask16;
+            // Aligned loads and stores: every `Lanes` is 64 bytes aligned to 64.
+            let load = |l: &super::Lanes| _mm512_load_ps(l.0.as_ptr());
+            let [kx, ky, kz] = r.axes;
+            let o_k = [load(&r.origin_k[0]), load(&r.origin_k[1]), load(&r.origin_k[2])];
+            let (sx, sy, sz) = (load(&r.shear[0]), load(&r.shear[1]), load(&r.shear[2]));
+            let zero = _mm512_setzero_ps();
+            let abs = |x: __m512| _mm512_abs_ps(x);
+            let normal = |x: __m512| {
+                _mm512_cmp_ps_mask::<_CMP_GE_OQ>(abs(x), _mm512_set1_ps(f32::MIN_POSITIVE))
+                    & _mm512_cmp_ps_mask::<_CMP_LT_OQ>(abs(x), _mm512_set1_ps(f32::INFINITY))
             };
-            let (ax, ay, a_z) = project(0);
-            let (bx, by, b_z) = project(1);
-            let (cx, cy, c_z) = project(2);
-            let e0 = _mm512_sub_ps(_mm512_mul_ps(cx, by), _mm512_mul_ps(cy, bx));
-            let e1 = _mm512_sub_ps(_mm512_mul_ps(ax, cy), _mm512_mul_ps(ay, cx));
-            let e2 = _mm512_sub_ps(_mm512_mul_ps(bx, ay), _mm512_mul_ps(by, ax));
-            let lt = |e| _mm512_cmp_ps_mask::<_CMP_LT_OQ>(e, zero);
-            let gt = |e| _mm512_cmp_ps_mask::<_CMP_GT_OQ>(e, zero);
-            let negative = lt(e0) | lt(e1) | lt(e2);
-            let positive = gt(e0) | gt(e1) | gt(e2);
-            let inside = !(negative & positive) & rays;
-            if inside == 0 {
-                continue;
-            }
-            let all_normal = normal(e0) & normal(e1) & normal(e2);
-            let mut special = inside & !all_normal;
-            let candidate = inside & all_normal;
-            if candidate != 0 {
-                let (az, bz, cz) = (_mm512_mul_ps(sz, a_z), _mm512_mul_ps(sz, b_z), _mm512_mul_ps(sz, c_z));
-                let det = _mm512_add_ps(_mm512_add_ps(e0, e1), e2);
-                let t_scaled =
-                    _mm512_add_ps(_mm512_add_ps(_mm512_mul_ps(e0, az), _mm512_mul_ps(e1, bz)), _mm512_mul_ps(e2, cz));
-                let inv_det = _mm512_div_ps(_mm512_set1_ps(1.0), det);
-                let t = _mm512_mul_ps(t_scaled, inv_det);
-                let finite = _mm512_cmp_ps_mask::<_CMP_LT_OQ>(abs(t), _mm512_set1_ps(f32::INFINITY));
-                special |= candidate & !finite;
-                let candidate = candidate & finite;
-                // The box-stretch correction, as the block test computes it.
-                let (mut enter, mut exit) = (_mm512_set1_ps(f32::NEG_INFINITY), _mm512_set1_ps(f32::INFINITY));
-                for axis in 0..3 {
-                    let (p, q, s) = (at(0, axis), at(1, axis), at(2, axis));
-                    let (lo, hi) = (_mm512_set1_ps(p.min(q).min(s)), _mm512_set1_ps(p.max(q).max(s)));
-                    let inv = load(&packet.inv_dir[axis]);
-                    let o = load(&packet.origin[axis]);
-                    let positive_dir = _mm512_cmp_ps_mask::<_CMP_GE_OQ>(inv, zero);
-                    let near = _mm512_mask_blend_ps(positive_dir, hi, lo);
-                    let far = _mm512_mask_blend_ps(positive_dir, lo, hi);
-                    let t_near = _mm512_mul_ps(_mm512_sub_ps(near, o), inv);
-                    let t_far =
-                        _mm512_mul_ps(_mm512_mul_ps(_mm512_sub_ps(far, o), inv), _mm512_set1_ps(ROBUST_FAR_SCALE));
-                    // `max(a, b)` is `a > b ? a : b`: the block test's `keep_greater`.
-                    enter = _mm512_max_ps(t_near, enter);
-                    exit = _mm512_min_ps(t_far, exit);
+            let (mut hit_rays, mut special_pairs) = (0u16, 0u64);
+            for lane in 0..LANES {
+                let id = block.ids[lane];
+                if id == UNUSED {
+                    continue;
                 }
-                let in_box = _mm512_cmp_ps_mask::<_CMP_LE_OQ>(enter, exit);
-                let t = _mm512_mask_blend_ps(_mm512_cmp_ps_mask::<_CMP_LT_OQ>(t, enter), t, enter);
-                let t = _mm512_mask_blend_ps(_mm512_cmp_ps_mask::<_CMP_GT_OQ>(t, exit), t, exit);
-                let best_t = load(&best.t);
-                let in_range = _mm512_cmp_ps_mask::<_CMP_GE_OQ>(t, load(&packet.t_min))
-                    & _mm512_cmp_ps_mask::<_CMP_LE_OQ>(t, best_t);
-                let hit = candidate & in_box & in_range;
-                hit_rays |= hit;
-                if closest && hit != 0 {
-                    let prim = _mm512_set1_epi32(id as i32);
-                    let best_prim = _mm512_castps_si512(load(&best.prim));
-                    let better = hit
-                        & (_mm512_cmp_ps_mask::<_CMP_LT_OQ>(t, best_t)
-                            | (_mm512_cmp_ps_mask::<_CMP_EQ_OQ>(t, best_t) & _mm512_cmplt_epu32_mask(prim, best_prim)));
-                    let store = |l: &mut super::Lanes, x: __m512| {
-                        // SAFETY: as `load`.
-                        unsafe { _mm512_store_ps(l.0.as_mut_ptr(), _mm512_mask_blend_ps(better, load(l), x)) }
-                    };
-                    store(&mut best.t, t);
-                    store(&mut best.u, _mm512_mul_ps(e1, inv_det));
-                    store(&mut best.v, _mm512_mul_ps(e2, inv_det));
-                    store(&mut best.prim, _mm512_castsi512_ps(prim));
+                let at = |k: usize, axis: usize| block.v[3 * k + axis][lane];
+                // Vertex k relative to the origin, sheared: the block test's `ax`, `ay`, `az`.
+                // A macro rather than a closure: the closure, called three times, stayed a call.
+                macro_rules! project {
+                    ($k:expr) => {{
+                        let x = _mm512_sub_ps(_mm512_set1_ps(at($k, kx)), o_k[0]);
+                        let y = _mm512_sub_ps(_mm512_set1_ps(at($k, ky)), o_k[1]);
+                        let z = _mm512_sub_ps(_mm512_set1_ps(at($k, kz)), o_k[2]);
+                        (_mm512_sub_ps(x, _mm512_mul_ps(sx, z)), _mm512_sub_ps(y, _mm512_mul_ps(sy, z)), z)
+                    }};
                 }
+                let (ax, ay, a_z) = project!(0);
+                let (bx, by, b_z) = project!(1);
+                let (cx, cy, c_z) = project!(2);
+                let e0 = _mm512_sub_ps(_mm512_mul_ps(cx, by), _mm512_mul_ps(cy, bx));
+                let e1 = _mm512_sub_ps(_mm512_mul_ps(ax, cy), _mm512_mul_ps(ay, cx));
+                let e2 = _mm512_sub_ps(_mm512_mul_ps(bx, ay), _mm512_mul_ps(by, ax));
+                let lt = |e| _mm512_cmp_ps_mask::<_CMP_LT_OQ>(e, zero);
+                let gt = |e| _mm512_cmp_ps_mask::<_CMP_GT_OQ>(e, zero);
+                let negative = lt(e0) | lt(e1) | lt(e2);
+                let positive = gt(e0) | gt(e1) | gt(e2);
+                let inside = !(negative & positive) & rays;
+                if inside == 0 {
+                    continue;
+                }
+                let all_normal = normal(e0) & normal(e1) & normal(e2);
+                let mut special = inside & !all_normal;
+                let candidate = inside & all_normal;
+                if candidate != 0 {
+                    let (az, bz, cz) = (_mm512_mul_ps(sz, a_z), _mm512_mul_ps(sz, b_z), _mm512_mul_ps(sz, c_z));
+                    let det = _mm512_add_ps(_mm512_add_ps(e0, e1), e2);
+                    let t_scaled = _mm512_add_ps(
+                        _mm512_add_ps(_mm512_mul_ps(e0, az), _mm512_mul_ps(e1, bz)),
+                        _mm512_mul_ps(e2, cz),
+                    );
+                    let inv_det = _mm512_div_ps(_mm512_set1_ps(1.0), det);
+                    let t = _mm512_mul_ps(t_scaled, inv_det);
+                    let finite = _mm512_cmp_ps_mask::<_CMP_LT_OQ>(abs(t), _mm512_set1_ps(f32::INFINITY));
+                    special |= candidate & !finite;
+                    let candidate = candidate & finite;
+                    // The box-stretch correction, as the block test computes it.
+                    let (mut enter, mut exit) = (_mm512_set1_ps(f32::NEG_INFINITY), _mm512_set1_ps(f32::INFINITY));
+                    for axis in 0..3 {
+                        let (p, q, s) = (at(0, axis), at(1, axis), at(2, axis));
+                        let (lo, hi) = (_mm512_set1_ps(p.min(q).min(s)), _mm512_set1_ps(p.max(q).max(s)));
+                        let inv = load(&packet.inv_dir[axis]);
+                        let o = load(&packet.origin[axis]);
+                        let positive_dir = _mm512_cmp_ps_mask::<_CMP_GE_OQ>(inv, zero);
+                        let near = _mm512_mask_blend_ps(positive_dir, hi, lo);
+                        let far = _mm512_mask_blend_ps(positive_dir, lo, hi);
+                        let t_near = _mm512_mul_ps(_mm512_sub_ps(near, o), inv);
+                        let t_far =
+                            _mm512_mul_ps(_mm512_mul_ps(_mm512_sub_ps(far, o), inv), _mm512_set1_ps(ROBUST_FAR_SCALE));
+                        // `max(a, b)` is `a > b ? a : b`: the block test's `keep_greater`.
+                        enter = _mm512_max_ps(t_near, enter);
+                        exit = _mm512_min_ps(t_far, exit);
+                    }
+                    let in_box = _mm512_cmp_ps_mask::<_CMP_LE_OQ>(enter, exit);
+                    let t = _mm512_mask_blend_ps(_mm512_cmp_ps_mask::<_CMP_LT_OQ>(t, enter), t, enter);
+                    let t = _mm512_mask_blend_ps(_mm512_cmp_ps_mask::<_CMP_GT_OQ>(t, exit), t, exit);
+                    let best_t = load(&best.t);
+                    let in_range = _mm512_cmp_ps_mask::<_CMP_GE_OQ>(t, load(&packet.t_min))
+                        & _mm512_cmp_ps_mask::<_CMP_LE_OQ>(t, best_t);
+                    let hit = candidate & in_box & in_range;
+                    hit_rays |= hit;
+                    if closest && hit != 0 {
+                        let prim = _mm512_set1_epi32(id as i32);
+                        let best_prim = _mm512_castps_si512(load(&best.prim));
+                        let better = hit
+                            & (_mm512_cmp_ps_mask::<_CMP_LT_OQ>(t, best_t)
+                                | (_mm512_cmp_ps_mask::<_CMP_EQ_OQ>(t, best_t)
+                                    & _mm512_cmplt_epu32_mask(prim, best_prim)));
+                        let store = |l: &mut super::Lanes, x: __m512| {
+                            _mm512_store_ps(l.0.as_mut_ptr(), _mm512_mask_blend_ps(better, load(l), x))
+                        };
+                        store(&mut best.t, t);
+                        store(&mut best.u, _mm512_mul_ps(e1, inv_det));
+                        store(&mut best.v, _mm512_mul_ps(e2, inv_det));
+                        store(&mut best.prim, _mm512_castsi512_ps(prim));
+                    }
+                }
+                special_pairs |= (special as u64) << (16 * lane);
             }
-            special_pairs |= (special as u64) << (16 * lane);
+            (hit_rays as u32, special_pairs)
         }
-        (hit_rays as u32, special_pairs)
     }
 }

@@ -1,205 +1,27 @@
 //! Packets of rays on [`TriangleBvh`]: up to [`PACKET`] rays walk the tree together (see
 //! [`super::packet`]); at a leaf, each triangle is tested against the whole packet when the
-//! processor has AVX-512 and the rays share the watertight test's axes (see
-//! [`super::packet_triangles`]), each ray tests the blocks alone otherwise. Either way every ray
-//! gets exactly the answer of its own query. Batches choose, sixteen rays at a time, between a
-//! packet (coherent rays: near origins, near directions) and single rays.
+//! processor has AVX-512 (see [`super::packet_triangles`]; a packet whose rays do not share the
+//! watertight test's axes is asked again ray by ray), each ray tests the blocks alone otherwise
+//! (the leaves' tests are in `triangle_packet_leaves`). Either way every ray gets exactly the
+//! answer of its own query. Batches choose, sixteen rays at a time, between a packet (coherent
+//! rays: near origins, near directions) and single rays.
 
 use std::marker::PhantomData;
 
 use super::dispatch;
-use super::isa::Isa;
-use super::node::{NodeRay, reach};
-use super::packet::{self, PacketLeaves};
-use super::packet_kernels::{Lanes, PACKET, PacketRays};
 #[cfg(target_arch = "x86_64")]
-use super::packet_triangles;
-use super::packet_triangles::{PacketBest, PacketTriRays};
+use super::isa::Isa;
+use super::packet;
+use super::packet_kernels::{PACKET, PacketRays};
+use super::packet_triangles::PacketBest;
 use super::ray_packet::{PacketHits, RayPacket};
-use super::traverse::Leaves;
 use super::triangle_bvh::TriangleBvh;
-use super::triangle_leaves;
-use super::triangles::TriRay;
+#[cfg(target_arch = "x86_64")]
+use super::triangle_packet_leaves::WholePacket;
+use super::triangle_packet_leaves::{RayByRay, TrianglePacket};
 use crate::accel::interface::batch::{run_batch_packets, run_packets};
 use crate::accel::{BatchSizeMismatch, Counters, Hit, NoCount, NoFilter};
-use crate::geom::prefetch::prefetch;
 use crate::{Aabb, Ray};
-
-/// The rays of a packet and their closest hits so far, as structures of arrays. With AVX-512 and
-/// rays sharing the watertight test's axes, each triangle is tested against the whole packet at
-/// once; otherwise each ray's leaves are tested by the single-ray leaf test.
-struct TrianglePacket<'a> {
-    /// The rays, prepared for node tests (their origins, inverse directions and `t_min` are read
-    /// by the whole-packet triangle test too; the single-ray tests take each ray back out).
-    packet: &'a PacketRays,
-    bvh: &'a TriangleBvh,
-    /// The shared-axes constants, when the packet's triangle tests run on whole packets;
-    /// prepared at the first leaf (rays that reach none never pay for them).
-    simd: Option<PacketTriRays>,
-    /// Whether `simd` has been decided (it stays `None` for rays of different axes, and on
-    /// processors without AVX-512).
-    decided: bool,
-    active: u32,
-    best: PacketBest,
-    limits: Lanes,
-}
-
-impl<'a> TrianglePacket<'a> {
-    /// The state of a packet of which `active` will be traced, within `limits` (see [`reach`]):
-    /// no hit yet.
-    fn new(bvh: &'a TriangleBvh, packet: &'a PacketRays, limits: Lanes, active: u32) -> Self {
-        // Only AVX-512 has the whole-packet triangle test.
-        let decided = !(cfg!(target_arch = "x86_64") && bvh.isa() == Isa::Avx512);
-        TrianglePacket { packet, bvh, simd: None, decided, active, best: PacketBest::new(&packet.t_max), limits }
-    }
-
-    /// The whole-packet triangle constants, if the packet's rays share their axes (see `simd`).
-    #[inline(always)]
-    fn simd(&mut self) -> Option<PacketTriRays> {
-        if !self.decided {
-            self.decided = true;
-            self.simd = PacketTriRays::new(self.packet, self.active);
-        }
-        self.simd
-    }
-
-    /// Tests the blocks from `first` against the rays of `rays` a whole packet at a time; returns
-    /// the rays that hit one (with `closest`, their closest hits are kept).
-    #[cfg(target_arch = "x86_64")]
-    #[inline(always)]
-    fn simd_blocks<C: Counters>(
-        &mut self,
-        tri: &PacketTriRays,
-        first: u32,
-        count: u32,
-        rays: u32,
-        closest: bool,
-        counters: &mut C,
-    ) -> u32 {
-        let mut found = 0;
-        for block in &self.bvh.blocks()[first as usize..(first + count) as usize] {
-            for _ in 0..block.used() * rays.count_ones() {
-                counters.exact_test();
-            }
-            // Any hit: the rays that found an occluder are done.
-            let pending = if closest { rays } else { rays & !found };
-            // SAFETY: `simd` is only prepared for structures whose instruction set is AVX-512,
-            // which the processor has (see `Isa`).
-            let (hit, mut special) =
-                unsafe { packet_triangles::block_avx512(block, self.packet, tri, pending, &mut self.best, closest) };
-            found |= hit;
-            while special != 0 {
-                let bit = special.trailing_zeros() as usize;
-                special &= special - 1;
-                let (lane, i) = (bit / PACKET, bit % PACKET);
-                if closest || found >> i & 1 == 0 {
-                    let t_max = self.best.t.0[i];
-                    if let Some(h) = TriRay::scalar(&self.packet.ray(i), block, lane, t_max) {
-                        found |= 1 << i;
-                        self.best.offer(i, Hit { t: h.t, prim: block.ids[lane], u: h.u, v: h.v });
-                    }
-                }
-            }
-            if !closest && found == rays {
-                break;
-            }
-        }
-        found
-    }
-}
-
-impl<C: Counters> PacketLeaves<C> for TrianglePacket<'_> {
-    #[inline(always)]
-    fn closest(&mut self, first: u32, count: u32, mut rays: u32, counters: &mut C) {
-        #[cfg(target_arch = "x86_64")]
-        if let Some(tri) = self.simd() {
-            self.simd_blocks(&tri, first, count, rays, true, counters);
-            while rays != 0 {
-                let i = rays.trailing_zeros() as usize;
-                rays &= rays - 1;
-                self.limits.0[i] = reach(self.best.t.0[i]);
-            }
-            return;
-        }
-        // Ray by ray, each with the single-ray leaf test (the rays' triangle constants are
-        // prepared at each leaf: only packets whose rays went apart come here).
-        while rays != 0 {
-            let i = rays.trailing_zeros() as usize;
-            rays &= rays - 1;
-            let source = self.packet.ray(i);
-            let best = triangle_leaves::closest_hit(self.bvh.blocks(), &source, self.best.t.0[i], NoFilter, |lane| {
-                let ray = Leaves::<C>::prepare(lane);
-                Leaves::<C>::closest(lane, &ray, first, count, counters);
-                Leaves::<C>::settle_closest(lane);
-            });
-            if let Some(hit) = best {
-                self.best.offer(i, hit);
-            }
-            self.limits.0[i] = reach(self.best.t.0[i]);
-        }
-    }
-
-    #[inline(always)]
-    fn any(&mut self, first: u32, count: u32, mut rays: u32, counters: &mut C) -> u32 {
-        #[cfg(target_arch = "x86_64")]
-        if let Some(tri) = self.simd() {
-            return self.simd_blocks(&tri, first, count, rays, false, counters);
-        }
-        let mut found = 0;
-        while rays != 0 {
-            let i = rays.trailing_zeros() as usize;
-            rays &= rays - 1;
-            let source = self.packet.ray(i);
-            if triangle_leaves::any_hit(self.bvh.blocks(), &source, self.best.t.0[i], NoFilter, |lane| {
-                let ray = Leaves::<C>::prepare(lane);
-                Leaves::<C>::any(lane, &ray, first, count, counters) || Leaves::<C>::settle_any(lane)
-            }) {
-                found |= 1 << i;
-            }
-        }
-        found
-    }
-
-    #[inline(always)]
-    fn limits(&self) -> &Lanes {
-        &self.limits
-    }
-
-    #[inline(always)]
-    fn prefetch(&self, first: u32) {
-        prefetch(self.bvh.blocks(), first);
-    }
-
-    #[inline(never)]
-    fn alone(&mut self, reference: u32, mut rays: u32, closest: bool, counters: &mut C) -> u32 {
-        let bvh = self.bvh;
-        let mut found = 0;
-        while rays != 0 {
-            let i = rays.trailing_zeros() as usize;
-            rays &= rays - 1;
-            let source = &self.packet.ray(i);
-            let node_ray = NodeRay::new(source);
-            let (blocks, t_max) = (bvh.blocks(), self.best.t.0[i]);
-            if closest {
-                let best = triangle_leaves::closest_hit(blocks, source, t_max, NoFilter, |lane| {
-                    dispatch::closest(bvh.isa(), bvh.nodes(), bvh.depth(), reference, &node_ray, lane, counters)
-                });
-                if let Some(hit) = best {
-                    self.best.offer(i, hit);
-                }
-                self.limits.0[i] = reach(self.best.t.0[i]);
-            } else {
-                let limit = reach(source.t_max);
-                if triangle_leaves::any_hit(blocks, source, t_max, NoFilter, |lane| {
-                    dispatch::any(bvh.isa(), bvh.nodes(), bvh.depth(), reference, &node_ray, limit, lane, counters)
-                }) {
-                    found |= 1 << i;
-                }
-            }
-        }
-        found
-    }
-}
 
 /// The valid rays of `rays` (at most [`PACKET`]), bit per ray ([`Ray::is_valid`]).
 pub(crate) fn valid_mask(rays: &[Ray]) -> u32 {
@@ -324,7 +146,15 @@ impl TriangleBvh {
             return best;
         }
         packet.bound(active);
-        let mut leaves = TrianglePacket::new(self, packet, limits, active);
+        #[cfg(target_arch = "x86_64")]
+        if self.isa() == Isa::Avx512 {
+            let mut leaves = TrianglePacket::new(self, packet, limits, WholePacket::new(active));
+            // SAFETY: the structure's instruction set is one the processor has (see `Isa`).
+            unsafe { dispatch::closest_packet_avx512(self.nodes(), packet, active, &mut leaves, counters) };
+            leaves.settle_closest(counters);
+            return leaves.best;
+        }
+        let mut leaves = TrianglePacket::new(self, packet, limits, RayByRay);
         dispatch::closest_packet(self.isa(), self.nodes(), packet, active, &mut leaves, counters);
         leaves.best
     }
@@ -404,7 +234,14 @@ impl TriangleBvh {
             return 0;
         }
         packet.bound(active);
-        let mut leaves = TrianglePacket::new(self, packet, limits, active);
+        #[cfg(target_arch = "x86_64")]
+        if self.isa() == Isa::Avx512 {
+            let mut leaves = TrianglePacket::new(self, packet, limits, WholePacket::new(active));
+            // SAFETY: the structure's instruction set is one the processor has (see `Isa`).
+            let found = unsafe { dispatch::any_packet_avx512(self.nodes(), packet, active, &mut leaves, counters) };
+            return leaves.settle_any(found, counters);
+        }
+        let mut leaves = TrianglePacket::new(self, packet, limits, RayByRay);
         dispatch::any_packet(self.isa(), self.nodes(), packet, active, &mut leaves, counters)
     }
 }

@@ -1,0 +1,327 @@
+//! A packet's leaf tests in a [`TriangleBvh`]: with AVX-512, each triangle against the whole
+//! packet at once ([`WholePacket`], see [`super::packet_triangles`]); otherwise each ray against
+//! the blocks alone ([`RayByRay`], the single-ray leaf test of [`super::triangle_leaves`]).
+//!
+//! The whole-packet walk has no call in its loop. x86-64 gives every vector register to the
+//! caller to save, so a call anywhere in the loop, even one never made, has the compiler keep the
+//! walk's state in memory (see [`super::triangle_leaves`], and `docs/performance.md`: this made
+//! primary packets 4.6-8.2 % faster). So the triangle test is compiled into the walk, and:
+//!
+//! * the pairs of ray and triangle it leaves undecided (a ray through an edge or a vertex) are
+//!   noted, and decided by the scalar test when the walk has ended
+//!   ([`TrianglePacket::settle_closest`], [`TrianglePacket::settle_any`]). The answers are those
+//!   of deciding each pair when it is met, for the reasons [`super::triangle_leaves`] gives. A
+//!   ray that meets more pairs than the list holds is asked again alone;
+//! * a packet whose rays do not share the watertight test's axes (which the whole-packet test
+//!   needs; the tiles of an image that straddle a change of the rays' largest axis) finds it out
+//!   at its first leaf, ends its walk there, and each ray is asked again alone.
+//!
+//! A ray asked again alone gets the single-ray query's answer, its own, which is the closest of
+//! every hit, so of any the packet found for it.
+
+use super::dispatch;
+use super::node::{NodeRay, reach};
+use super::packet::PacketLeaves;
+use super::packet_kernels::{Lanes, PACKET, PacketRays};
+use super::packet_triangles::{PacketBest, PacketTriRays};
+use super::traverse::Leaves;
+use super::triangle_bvh::TriangleBvh;
+use super::triangle_leaves;
+use super::triangles::TriRay;
+use crate::accel::{Counters, Hit, NoFilter};
+use crate::geom::prefetch::prefetch;
+
+/// The undecided pairs a packet notes in its walk.
+const DEFERRED: usize = 16;
+
+/// The rays of a packet and their closest hits so far, as structures of arrays, tested at leaves
+/// by `T` ([`WholePacket`] or [`RayByRay`]).
+pub(super) struct TrianglePacket<'a, T> {
+    /// The rays, prepared for node tests (their origins, inverse directions and `t_min` are read
+    /// by the whole-packet triangle test too; the single-ray tests take each ray back out).
+    packet: &'a PacketRays,
+    bvh: &'a TriangleBvh,
+    pub(super) best: PacketBest,
+    limits: Lanes,
+    test: T,
+}
+
+/// Each triangle tested against the whole packet (AVX-512), with the pairs the test leaves
+/// undecided.
+#[cfg(target_arch = "x86_64")]
+pub(super) struct WholePacket {
+    /// The rays walked.
+    active: u32,
+    /// Their triangle constants, prepared at the first leaf: a packet that reaches none (as most
+    /// of those around a mesh framed by the camera) never pays for them.
+    tri: Option<PacketTriRays>,
+    /// The undecided pairs noted: a block's index, and `16 * lane + ray`.
+    noted: [(u32, u8); DEFERRED],
+    /// How many of `noted` are used.
+    len: usize,
+    /// The rays asked again alone when the walk has ended: those that met more undecided pairs
+    /// than `noted` holds, or all of them if they do not share the test's axes.
+    again: u32,
+}
+
+/// Each ray tested against the blocks alone, with the single-ray leaf test.
+pub(super) struct RayByRay;
+
+impl<'a, T> TrianglePacket<'a, T> {
+    /// The state of a packet within `limits` (see [`reach`]): no hit yet.
+    pub(super) fn new(bvh: &'a TriangleBvh, packet: &'a PacketRays, limits: Lanes, test: T) -> Self {
+        TrianglePacket { packet, bvh, best: PacketBest::new(&packet.t_max), limits, test }
+    }
+
+    /// Walks the subtree of `reference` with each ray of `rays` alone (see
+    /// [`PacketLeaves::alone`]).
+    #[inline(never)]
+    fn alone_walks<C: Counters>(&mut self, reference: u32, mut rays: u32, closest: bool, counters: &mut C) -> u32 {
+        let bvh = self.bvh;
+        let mut found = 0;
+        while rays != 0 {
+            let i = rays.trailing_zeros() as usize;
+            rays &= rays - 1;
+            let source = &self.packet.ray(i);
+            let node_ray = NodeRay::new(source);
+            let (blocks, t_max) = (bvh.blocks(), self.best.t.0[i]);
+            if closest {
+                let best = triangle_leaves::closest_hit(blocks, source, t_max, NoFilter, |lane| {
+                    dispatch::closest(bvh.isa(), bvh.nodes(), bvh.depth(), reference, &node_ray, lane, counters)
+                });
+                if let Some(hit) = best {
+                    self.best.offer(i, hit);
+                }
+                self.limits.0[i] = reach(self.best.t.0[i]);
+            } else {
+                let limit = reach(source.t_max);
+                if triangle_leaves::any_hit(blocks, source, t_max, NoFilter, |lane| {
+                    dispatch::any(bvh.isa(), bvh.nodes(), bvh.depth(), reference, &node_ray, limit, lane, counters)
+                }) {
+                    found |= 1 << i;
+                }
+            }
+        }
+        found
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+impl WholePacket {
+    /// The whole-packet test of the rays of `active`.
+    pub(super) fn new(active: u32) -> Self {
+        WholePacket { active, tri: None, noted: [(0, 0); DEFERRED], len: 0, again: 0 }
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+impl TrianglePacket<'_, WholePacket> {
+    /// Tests the blocks from `first` against the rays of `rays` a whole packet at a time; returns
+    /// the rays that hit one (with `closest`, their closest hits are kept). Notes the pairs left
+    /// undecided.
+    ///
+    /// # Safety
+    /// The processor has AVX-512 (the test is compiled into the caller, which should enable it).
+    #[inline(always)]
+    unsafe fn test_blocks<C: Counters>(
+        &mut self,
+        first: u32,
+        count: u32,
+        rays: u32,
+        closest: bool,
+        counters: &mut C,
+    ) -> u32 {
+        use super::packet_triangles::block_avx512;
+        if self.test.tri.is_none() {
+            match PacketTriRays::shared_axes(self.packet, self.test.active) {
+                Some(axes) => self.test.tri = Some(PacketTriRays::new(self.packet, self.test.active, axes)),
+                None => return self.give_up(),
+            }
+        }
+        // Borrowed field by field: the constants are read where they lie, not copied per leaf.
+        let TrianglePacket { packet, bvh, best, test: WholePacket { tri: Some(tri), noted, len, again, .. }, .. } =
+            self
+        else {
+            unreachable!("prepared above")
+        };
+        let mut found = 0;
+        for (b, block) in bvh.blocks()[first as usize..(first + count) as usize].iter().enumerate() {
+            for _ in 0..block.used() * rays.count_ones() {
+                counters.exact_test();
+            }
+            // Any hit: the rays that found an occluder are done.
+            let pending = if closest { rays } else { rays & !found };
+            // SAFETY: the caller's guarantee.
+            let (hit, mut special) = unsafe { block_avx512(block, packet, tri, pending, best, closest) };
+            found |= hit;
+            while special != 0 {
+                let bit = special.trailing_zeros();
+                special &= special - 1;
+                if *len < DEFERRED {
+                    noted[*len] = (first + b as u32, bit as u8);
+                    *len += 1;
+                } else {
+                    *again |= 1 << (bit as usize % PACKET);
+                }
+            }
+            if !closest && found == rays {
+                break;
+            }
+        }
+        found
+    }
+
+    /// Ends the walk of a packet whose rays do not share the test's axes (the tiles of an image
+    /// that straddle a change of the rays' largest axis; rare): no box is entered any more, and
+    /// every ray is asked again alone. Returns every ray as if it had hit, which ends an any-hit
+    /// walk (the settling leaves them out of the answer).
+    #[inline(always)]
+    fn give_up(&mut self) -> u32 {
+        self.test.again = self.test.active;
+        self.limits = Lanes([f32::NEG_INFINITY; PACKET]);
+        self.test.active
+    }
+
+    /// Decides the pairs the walk noted, and asks the rays that met too many again: each ray's
+    /// closest hit is then its own query's.
+    pub(super) fn settle_closest<C: Counters>(&mut self, counters: &mut C) {
+        let w = &self.test;
+        for &(block, bit) in &w.noted[..w.len] {
+            let (lane, i) = (bit as usize / PACKET, bit as usize % PACKET);
+            if w.again >> i & 1 == 0 {
+                let block = &self.bvh.blocks()[block as usize];
+                if let Some(h) = TriRay::scalar(&self.packet.ray(i), block, lane, self.best.t.0[i]) {
+                    self.best.offer(i, Hit { t: h.t, prim: block.ids[lane], u: h.u, v: h.v });
+                }
+            }
+        }
+        let mut again = w.again;
+        while again != 0 {
+            let i = again.trailing_zeros() as usize;
+            again &= again - 1;
+            // The query's answer is the closest of every hit, so of those the walk found too.
+            if let Some(hit) = self.bvh.closest_hit_of_valid(&self.packet.ray(i), counters, NoFilter) {
+                self.best.offer(i, hit);
+            }
+        }
+    }
+
+    /// The rays that hit something, from those the walk reports (`walked`): those it found a hit
+    /// for and does not ask again, those that hit one of the pairs it noted, and those asked
+    /// again that hit anything.
+    pub(super) fn settle_any<C: Counters>(&self, walked: u32, counters: &mut C) -> u32 {
+        let w = &self.test;
+        let mut found = walked & !w.again;
+        for &(block, bit) in &w.noted[..w.len] {
+            let (lane, i) = (bit as usize / PACKET, bit as usize % PACKET);
+            if (!found & !w.again) >> i & 1 != 0 {
+                let block = &self.bvh.blocks()[block as usize];
+                if TriRay::scalar(&self.packet.ray(i), block, lane, self.best.t.0[i]).is_some() {
+                    found |= 1 << i;
+                }
+            }
+        }
+        let mut again = w.again;
+        while again != 0 {
+            let i = again.trailing_zeros() as usize;
+            again &= again - 1;
+            if self.bvh.any_hit_of_valid(&self.packet.ray(i), counters, NoFilter) {
+                found |= 1 << i;
+            }
+        }
+        found
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+impl<C: Counters> PacketLeaves<C> for TrianglePacket<'_, WholePacket> {
+    #[inline(always)]
+    fn closest(&mut self, first: u32, count: u32, mut rays: u32, counters: &mut C) {
+        // SAFETY: `WholePacket` is only made for structures whose instruction set is AVX-512,
+        // which the processor has (see `Isa`).
+        unsafe { self.test_blocks(first, count, rays, true, counters) };
+        if self.test.again == self.test.active {
+            return;
+        }
+        while rays != 0 {
+            let i = rays.trailing_zeros() as usize;
+            rays &= rays - 1;
+            self.limits.0[i] = reach(self.best.t.0[i]);
+        }
+    }
+
+    #[inline(always)]
+    fn any(&mut self, first: u32, count: u32, rays: u32, counters: &mut C) -> u32 {
+        // SAFETY: as in `closest`.
+        unsafe { self.test_blocks(first, count, rays, false, counters) }
+    }
+
+    #[inline(always)]
+    fn limits(&self) -> &Lanes {
+        &self.limits
+    }
+
+    #[inline(always)]
+    fn prefetch(&self, first: u32) {
+        prefetch(self.bvh.blocks(), first);
+    }
+
+    #[inline(always)]
+    fn alone(&mut self, reference: u32, rays: u32, closest: bool, counters: &mut C) -> u32 {
+        self.alone_walks(reference, rays, closest, counters)
+    }
+}
+
+impl<C: Counters> PacketLeaves<C> for TrianglePacket<'_, RayByRay> {
+    #[inline(always)]
+    fn closest(&mut self, first: u32, count: u32, mut rays: u32, counters: &mut C) {
+        // The rays' triangle constants are prepared at each leaf: only packets whose rays do not
+        // share their axes, or processors without AVX-512, come here.
+        while rays != 0 {
+            let i = rays.trailing_zeros() as usize;
+            rays &= rays - 1;
+            let source = self.packet.ray(i);
+            let best = triangle_leaves::closest_hit(self.bvh.blocks(), &source, self.best.t.0[i], NoFilter, |lane| {
+                let ray = Leaves::<C>::prepare(lane);
+                Leaves::<C>::closest(lane, &ray, first, count, counters);
+                Leaves::<C>::settle_closest(lane);
+            });
+            if let Some(hit) = best {
+                self.best.offer(i, hit);
+            }
+            self.limits.0[i] = reach(self.best.t.0[i]);
+        }
+    }
+
+    #[inline(always)]
+    fn any(&mut self, first: u32, count: u32, mut rays: u32, counters: &mut C) -> u32 {
+        let mut found = 0;
+        while rays != 0 {
+            let i = rays.trailing_zeros() as usize;
+            rays &= rays - 1;
+            let source = self.packet.ray(i);
+            if triangle_leaves::any_hit(self.bvh.blocks(), &source, self.best.t.0[i], NoFilter, |lane| {
+                let ray = Leaves::<C>::prepare(lane);
+                Leaves::<C>::any(lane, &ray, first, count, counters) || Leaves::<C>::settle_any(lane)
+            }) {
+                found |= 1 << i;
+            }
+        }
+        found
+    }
+
+    #[inline(always)]
+    fn limits(&self) -> &Lanes {
+        &self.limits
+    }
+
+    #[inline(always)]
+    fn prefetch(&self, first: u32) {
+        prefetch(self.bvh.blocks(), first);
+    }
+
+    #[inline(always)]
+    fn alone(&mut self, reference: u32, rays: u32, closest: bool, counters: &mut C) -> u32 {
+        self.alone_walks(reference, rays, closest, counters)
+    }
+}
