@@ -70,8 +70,17 @@ impl PacketRays {
     /// ask for them.
     #[inline(always)]
     pub fn new(rays: &[Ray]) -> Self {
-        debug_assert!(rays.len() <= PACKET);
         let mut p = PacketRays::EMPTY;
+        p.fill(rays);
+        p
+    }
+
+    /// [`PacketRays::new`] into a packet that is [`PacketRays::EMPTY`] (so that a caller which
+    /// keeps the packet in place has it filled there rather than copied).
+    #[inline(always)]
+    pub(super) fn fill(&mut self, rays: &[Ray]) {
+        debug_assert!(rays.len() <= PACKET);
+        let p = self;
         // What `NodeRay::new` computes, four rays at a time: their vectors transposed into rows
         // of four lanes by shuffles, each row stored whole. (Storing each ray's coordinates one
         // by one and reading them back as rows made every read wait for the stores before it.)
@@ -112,7 +121,6 @@ impl PacketRays {
             let moving = d.x_axis.cmpne(Vec4::ZERO) | d.y_axis.cmpne(Vec4::ZERO) | d.z_axis.cmpne(Vec4::ZERO);
             p.valid |= (finite & moving & nonempty(t_min, t_max)).bitmask() << (4 * k);
         }
-        p
     }
 
     /// How far each ray may enter a box ([`super::node::reach`] of its `t_max`), four lanes at a

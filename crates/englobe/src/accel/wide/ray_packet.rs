@@ -66,9 +66,18 @@ impl RayPacket {
 
     /// The packet prepared for the traversal, its rays valid only in `active`: what
     /// [`PacketRays::new`] makes of the same rays, computed row by row, four lanes at a time.
+    #[cfg(test)]
+    fn prepare(&self, active: u32) -> PacketRays {
+        let mut p = PacketRays::EMPTY;
+        self.prepare_into(active, &mut p);
+        p
+    }
+
+    /// [`RayPacket::prepare`] into `p` (in place: see `triangle_packet`'s `PacketSource`),
+    /// every field of which it writes.
     #[inline(always)]
-    pub(super) fn prepare(&self, active: u32) -> PacketRays {
-        let mut p = PacketRays { t_min: Lanes(self.t_min), t_max: Lanes(self.t_max), ..PacketRays::EMPTY };
+    pub(super) fn prepare_into(&self, active: u32, p: &mut PacketRays) {
+        (p.t_min, p.t_max, p.valid, p.down, p.interval) = (Lanes(self.t_min), Lanes(self.t_max), 0, [0; 3], None);
         for k in 0..PACKET / 4 {
             let lanes = 4 * k..4 * k + 4;
             let four = |row: &[f32; PACKET]| Vec4::from_slice(&row[lanes.clone()]);
@@ -89,7 +98,6 @@ impl RayPacket {
             p.valid |= (finite & moving & nonempty(t_min, t_max)).bitmask() << (4 * k);
         }
         p.valid &= active;
-        p
     }
 }
 
