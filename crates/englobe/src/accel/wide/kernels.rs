@@ -24,6 +24,14 @@ pub trait NodeKernel: Copy {
     /// The caller is compiled with the kernel's target features and runs on a processor that
     /// has them.
     unsafe fn children(self, node: &WideNode, ray: &NodeRay, limit: f32, dist: &mut [f32; WIDTH]) -> u32;
+
+    /// The same test, with `dist[i]` the distance at which the ray leaves child `i` (its exit,
+    /// within `limit`) instead of the one at which it enters: what occlusion walks order the
+    /// children by (see [`super::traverse`]).
+    ///
+    /// # Safety
+    /// As [`NodeKernel::children`].
+    unsafe fn children_exits(self, node: &WideNode, ray: &NodeRay, limit: f32, dist: &mut [f32; WIDTH]) -> u32;
 }
 
 /// Four lanes at a time through glam (SSE2 on x86-64, NEON on aarch64, scalar elsewhere).
@@ -33,6 +41,20 @@ pub struct Portable;
 impl NodeKernel for Portable {
     #[inline(always)]
     unsafe fn children(self, node: &WideNode, ray: &NodeRay, limit: f32, dist: &mut [f32; WIDTH]) -> u32 {
+        portable_slabs::<false>(node, ray, limit, dist)
+    }
+
+    #[inline(always)]
+    unsafe fn children_exits(self, node: &WideNode, ray: &NodeRay, limit: f32, dist: &mut [f32; WIDTH]) -> u32 {
+        portable_slabs::<true>(node, ray, limit, dist)
+    }
+}
+
+/// The portable kernel: the entered children, with their entry distances in `dist`, or their
+/// exit distances if `EXITS`.
+#[inline(always)]
+fn portable_slabs<const EXITS: bool>(node: &WideNode, ray: &NodeRay, limit: f32, dist: &mut [f32; WIDTH]) -> u32 {
+    {
         let mut mask = 0;
         for half in 0..2 {
             let row = |r: usize| Vec4::from_slice(&node.bounds[r][4 * half..4 * half + 4]);
@@ -45,7 +67,7 @@ impl NodeKernel for Portable {
                 exit = Vec4::select(t_far.cmplt(exit), t_far, exit);
             }
             mask |= enter.cmple(exit).bitmask() << (4 * half);
-            enter.write_to_slice(&mut dist[4 * half..4 * half + 4]);
+            (if EXITS { exit } else { enter }).write_to_slice(&mut dist[4 * half..4 * half + 4]);
         }
         mask
     }
@@ -99,6 +121,16 @@ mod x86 {
                 _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(enter, exit)) as u32
             }
         }
+
+        #[inline(always)]
+        unsafe fn children_exits(self, node: &WideNode, ray: &NodeRay, limit: f32, dist: &mut [f32; WIDTH]) -> u32 {
+            // SAFETY: as in `children`.
+            unsafe {
+                let (enter, exit) = slabs(node, ray, limit);
+                _mm256_storeu_ps(dist.as_mut_ptr(), exit);
+                _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(enter, exit)) as u32
+            }
+        }
     }
 
     /// Eight lanes with AVX-512 (VL): the comparison lands in a mask register.
@@ -112,6 +144,16 @@ mod x86 {
             unsafe {
                 let (enter, exit) = slabs(node, ray, limit);
                 _mm256_storeu_ps(dist.as_mut_ptr(), enter);
+                _mm256_cmp_ps_mask::<_CMP_LE_OQ>(enter, exit) as u32
+            }
+        }
+
+        #[inline(always)]
+        unsafe fn children_exits(self, node: &WideNode, ray: &NodeRay, limit: f32, dist: &mut [f32; WIDTH]) -> u32 {
+            // SAFETY: as in `children`.
+            unsafe {
+                let (enter, exit) = slabs(node, ray, limit);
+                _mm256_storeu_ps(dist.as_mut_ptr(), exit);
                 _mm256_cmp_ps_mask::<_CMP_LE_OQ>(enter, exit) as u32
             }
         }
@@ -151,6 +193,29 @@ mod tests {
             let expected = child_entry_scalar(node, slot, &r, limit);
             let got = (mask >> slot & 1 != 0).then_some(d);
             assert_eq!(expected.map(f32::to_bits), got.map(f32::to_bits), "{isa}: slot {slot} of {node:?}, {ray:?}");
+        }
+        // The same children with their exit distances, as the scalar test's `exit`.
+        let mut exits = [0.0; WIDTH];
+        // SAFETY: as above.
+        let exit_mask = unsafe {
+            match isa {
+                Isa::Portable => Portable.children_exits(node, &r, limit, &mut exits),
+                #[cfg(target_arch = "x86_64")]
+                Isa::Avx2 => Avx2.children_exits(node, &r, limit, &mut exits),
+                #[cfg(target_arch = "x86_64")]
+                Isa::Avx512 => Avx512.children_exits(node, &r, limit, &mut exits),
+                #[cfg(not(target_arch = "x86_64"))]
+                _ => unreachable!(),
+            }
+        };
+        assert_eq!(exit_mask, mask, "{isa}: {node:?}, {ray:?}");
+        for slot in (0..WIDTH).filter(|&slot| mask >> slot & 1 != 0) {
+            let mut exit = limit;
+            for a in 0..3 {
+                let t_far = (node.bounds[r.row_index(a, 1)][slot] - r.origin[a]) * r.inv_far[a];
+                exit = if t_far < exit { t_far } else { exit };
+            }
+            assert_eq!(exits[slot].to_bits(), exit.to_bits(), "{isa}: slot {slot} of {node:?}, {ray:?}");
         }
         mask.count_ones()
     }
