@@ -233,27 +233,29 @@ impl TrianglePacket<'_, WholePacket> {
     }
 }
 
-#[cfg(target_arch = "x86_64")]
-impl<C: Counters> PacketLeaves<C> for TrianglePacket<'_, WholePacket> {
+/// How a [`TrianglePacket`]'s leaves are tested: [`WholePacket`] or [`RayByRay`].
+pub(super) trait LeafTest: Sized {
+    /// [`PacketLeaves::closest`].
+    fn closest<C: Counters>(leaves: &mut TrianglePacket<'_, Self>, first: u32, count: u32, rays: u32, counters: &mut C);
+    /// [`PacketLeaves::any`].
+    fn any<C: Counters>(
+        leaves: &mut TrianglePacket<'_, Self>,
+        first: u32,
+        count: u32,
+        rays: u32,
+        counters: &mut C,
+    ) -> u32;
+}
+
+impl<C: Counters, T: LeafTest> PacketLeaves<C> for TrianglePacket<'_, T> {
     #[inline(always)]
-    fn closest(&mut self, first: u32, count: u32, mut rays: u32, counters: &mut C) {
-        // SAFETY: `WholePacket` is only made for structures whose instruction set is AVX-512,
-        // which the processor has (see `Isa`).
-        unsafe { self.test_blocks(first, count, rays, true, counters) };
-        if self.test.again == self.test.active {
-            return;
-        }
-        while rays != 0 {
-            let i = rays.trailing_zeros() as usize;
-            rays &= rays - 1;
-            self.limits.0[i] = reach(self.best.t.0[i]);
-        }
+    fn closest(&mut self, first: u32, count: u32, rays: u32, counters: &mut C) {
+        T::closest(self, first, count, rays, counters);
     }
 
     #[inline(always)]
     fn any(&mut self, first: u32, count: u32, rays: u32, counters: &mut C) -> u32 {
-        // SAFETY: as in `closest`.
-        unsafe { self.test_blocks(first, count, rays, false, counters) }
+        T::any(self, first, count, rays, counters)
     }
 
     #[inline(always)]
@@ -272,35 +274,84 @@ impl<C: Counters> PacketLeaves<C> for TrianglePacket<'_, WholePacket> {
     }
 }
 
-impl<C: Counters> PacketLeaves<C> for TrianglePacket<'_, RayByRay> {
+#[cfg(target_arch = "x86_64")]
+impl LeafTest for WholePacket {
     #[inline(always)]
-    fn closest(&mut self, first: u32, count: u32, mut rays: u32, counters: &mut C) {
-        // The rays' triangle constants are prepared at each leaf: only packets whose rays do not
-        // share their axes, or processors without AVX-512, come here.
+    fn closest<C: Counters>(
+        leaves: &mut TrianglePacket<'_, Self>,
+        first: u32,
+        count: u32,
+        mut rays: u32,
+        counters: &mut C,
+    ) {
+        // SAFETY: `WholePacket` is only made for structures whose instruction set is AVX-512,
+        // which the processor has (see `Isa`).
+        unsafe { leaves.test_blocks(first, count, rays, true, counters) };
+        if leaves.test.again == leaves.test.active {
+            return;
+        }
         while rays != 0 {
             let i = rays.trailing_zeros() as usize;
             rays &= rays - 1;
-            let source = self.packet.ray(i);
-            let best = triangle_leaves::closest_hit(self.bvh.blocks(), &source, self.best.t.0[i], NoFilter, |lane| {
+            leaves.limits.0[i] = reach(leaves.best.t.0[i]);
+        }
+    }
+
+    #[inline(always)]
+    fn any<C: Counters>(
+        leaves: &mut TrianglePacket<'_, Self>,
+        first: u32,
+        count: u32,
+        rays: u32,
+        counters: &mut C,
+    ) -> u32 {
+        // SAFETY: as in `closest`.
+        unsafe { leaves.test_blocks(first, count, rays, false, counters) }
+    }
+}
+
+impl LeafTest for RayByRay {
+    #[inline(always)]
+    fn closest<C: Counters>(
+        leaves: &mut TrianglePacket<'_, Self>,
+        first: u32,
+        count: u32,
+        mut rays: u32,
+        counters: &mut C,
+    ) {
+        // The rays' triangle constants are prepared at each leaf: only processors without
+        // AVX-512 come here.
+        while rays != 0 {
+            let i = rays.trailing_zeros() as usize;
+            rays &= rays - 1;
+            let source = leaves.packet.ray(i);
+            let t_max = leaves.best.t.0[i];
+            let best = triangle_leaves::closest_hit(leaves.bvh.blocks(), &source, t_max, NoFilter, |lane| {
                 let ray = Leaves::<C>::prepare(lane);
                 Leaves::<C>::closest(lane, &ray, first, count, counters);
                 Leaves::<C>::settle_closest(lane);
             });
             if let Some(hit) = best {
-                self.best.offer(i, hit);
+                leaves.best.offer(i, hit);
             }
-            self.limits.0[i] = reach(self.best.t.0[i]);
+            leaves.limits.0[i] = reach(leaves.best.t.0[i]);
         }
     }
 
     #[inline(always)]
-    fn any(&mut self, first: u32, count: u32, mut rays: u32, counters: &mut C) -> u32 {
+    fn any<C: Counters>(
+        leaves: &mut TrianglePacket<'_, Self>,
+        first: u32,
+        count: u32,
+        mut rays: u32,
+        counters: &mut C,
+    ) -> u32 {
         let mut found = 0;
         while rays != 0 {
             let i = rays.trailing_zeros() as usize;
             rays &= rays - 1;
-            let source = self.packet.ray(i);
-            if triangle_leaves::any_hit(self.bvh.blocks(), &source, self.best.t.0[i], NoFilter, |lane| {
+            let source = leaves.packet.ray(i);
+            if triangle_leaves::any_hit(leaves.bvh.blocks(), &source, leaves.best.t.0[i], NoFilter, |lane| {
                 let ray = Leaves::<C>::prepare(lane);
                 Leaves::<C>::any(lane, &ray, first, count, counters) || Leaves::<C>::settle_any(lane)
             }) {
@@ -308,20 +359,5 @@ impl<C: Counters> PacketLeaves<C> for TrianglePacket<'_, RayByRay> {
             }
         }
         found
-    }
-
-    #[inline(always)]
-    fn limits(&self) -> &Lanes {
-        &self.limits
-    }
-
-    #[inline(always)]
-    fn prefetch(&self, first: u32) {
-        prefetch(self.bvh.blocks(), first);
-    }
-
-    #[inline(always)]
-    fn alone(&mut self, reference: u32, rays: u32, closest: bool, counters: &mut C) -> u32 {
-        self.alone_walks(reference, rays, closest, counters)
     }
 }
