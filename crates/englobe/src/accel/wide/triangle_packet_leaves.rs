@@ -4,8 +4,9 @@
 //!
 //! The whole-packet walk has no call in its loop. x86-64 gives every vector register to the
 //! caller to save, so a call anywhere in the loop, even one never made, has the compiler keep the
-//! walk's state in memory (see [`super::triangle_leaves`], and `docs/performance.md`: this made
-//! primary packets 4.6-8.2 % faster). So the triangle test is compiled into the walk, and:
+//! walk's state in memory (see [`super::triangle_leaves`], and `docs/performance.md`: without
+//! them, primary packets ran 4-10 % faster on closest hits). So the triangle test is compiled
+//! into the walk, and:
 //!
 //! * the pairs of ray and triangle it leaves undecided (a ray through an edge or a vertex) are
 //!   noted, and decided by the scalar test when the walk has ended
