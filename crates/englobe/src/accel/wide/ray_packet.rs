@@ -64,17 +64,9 @@ impl RayPacket {
         Ray::segment(row(&self.origin), row(&self.dir), self.t_min[lane], self.t_max[lane])
     }
 
-    /// The packet prepared for the traversal, its rays valid only in `active`: what
+    /// The packet prepared for the traversal, its rays valid only in `active`, written into `p`
+    /// (every field of it; in place, see `triangle_packet`'s `PacketSource`): what
     /// [`PacketRays::new`] makes of the same rays, computed row by row, four lanes at a time.
-    #[cfg(test)]
-    fn prepare(&self, active: u32) -> PacketRays {
-        let mut p = PacketRays::EMPTY;
-        self.prepare_into(active, &mut p);
-        p
-    }
-
-    /// [`RayPacket::prepare`] into `p` (in place: see `triangle_packet`'s `PacketSource`),
-    /// every field of which it writes.
     #[inline(always)]
     pub(super) fn prepare_into(&self, active: u32, p: &mut PacketRays) {
         (p.t_min, p.t_max, p.valid, p.down, p.interval) = (Lanes(self.t_min), Lanes(self.t_max), 0, [0; 3], None);
@@ -163,7 +155,15 @@ mod tests {
                 rays.push(Ray::segment(o, d, t_min, t_max));
             }
             let active = (1u32 << len) - 1;
-            let (from_rows, from_rays) = (packet.prepare(active), PacketRays::new(&rays));
+            // Into a packet that holds other rays, an interval included: every field is written.
+            let prepare = |active: u32| {
+                let mut p = PacketRays::new(&[Ray::new(Vec3::splat(3.0), Vec3::new(-1.0, -2.0, -0.5)); PACKET]);
+                p.bound(u32::MAX >> (32 - PACKET));
+                assert!(p.interval.is_some());
+                packet.prepare_into(active, &mut p);
+                p
+            };
+            let (from_rows, from_rays) = (prepare(active), PacketRays::new(&rays));
             let bits = |l: &Lanes| l.0[..len].iter().map(|x| x.to_bits()).collect::<Vec<_>>();
             for a in 0..3 {
                 assert_eq!(bits(&from_rows.origin[a]), bits(&from_rays.origin[a]));
@@ -175,6 +175,7 @@ mod tests {
             assert_eq!(bits(&from_rows.t_min), bits(&from_rays.t_min));
             assert_eq!(bits(&from_rows.t_max), bits(&from_rays.t_max));
             assert_eq!(from_rows.valid, from_rays.valid);
+            assert_eq!(from_rows.interval, None);
             for (i, ray) in rays.iter().enumerate() {
                 assert_eq!(format!("{:?}", from_rows.ray(i)), format!("{ray:?}"), "lane {i}");
                 assert_eq!(format!("{:?}", packet.ray(i)), format!("{ray:?}"), "lane {i}");
@@ -182,7 +183,7 @@ mod tests {
                 invalid += !ray.is_valid() as u32;
             }
             // Lanes outside the mask are never valid.
-            assert_eq!(packet.prepare(active & 0x5555).valid, from_rays.valid & 0x5555);
+            assert_eq!(prepare(active & 0x5555).valid, from_rays.valid & 0x5555);
         }
         assert!(valid > 3_000 && invalid > 3_000, "{valid} valid, {invalid} invalid");
     }

@@ -16,7 +16,8 @@
 //! has long used the same rule ([`crate::accel::bvh::ordered`]); the wide one had not. "Farthest"
 //! is by where the ray leaves a box ([`NodeKernel::children_exits`]), not where it enters: a box
 //! the ray crosses for longer, out to a farther wall, is likelier to hold what stops it than one
-//! it enters late and leaves at once (another 2-7 % fewer nodes on random and shadow rays).
+//! it enters late and leaves at once (another 2-7 % fewer nodes on random rays, up to 2.4 % on
+//! the renderer's shadow rays).
 //!
 //! The traversal is generic over the node test ([`NodeKernel`], one per instruction set) and over
 //! what leaves hold ([`Leaves`]: primitive references tested by a closure, or blocks of
@@ -174,7 +175,7 @@ fn prepare_once<'p, C: Counters, L: Leaves<C>>(slot: &'p mut Option<L::Prepared>
 
 /// The lowest slot set in `mask`, cleared from it (`mask` must not be empty).
 #[inline(always)]
-fn take_lowest(mask: &mut u32) -> usize {
+pub(super) fn take_lowest(mask: &mut u32) -> usize {
     let slot = mask.trailing_zeros() as usize;
     *mask &= *mask - 1;
     slot

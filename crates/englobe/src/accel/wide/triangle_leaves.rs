@@ -204,15 +204,8 @@ impl<'a, F: HitFilter<Hit>> TriangleLeaves<'a, F> {
 
     /// The scalar test's hit of a noted lane within the interval, if any.
     #[inline(always)]
-    fn scalar_hit(&self, (index, lane): (u32, u8)) -> Option<Hit> {
-        let block = &self.blocks[index as usize];
-        let lane = lane as usize;
-        TriRay::scalar(self.source, block, lane, self.t_max).map(|h| Hit {
-            t: h.t,
-            prim: block.ids[lane],
-            u: h.u,
-            v: h.v,
-        })
+    fn scalar_hit(&self, (index, lane): Noted) -> Option<Hit> {
+        scalar_hit(self.blocks, self.source, index, lane as usize, self.t_max)
     }
 
     /// Offers the noted lanes' hits.
@@ -239,6 +232,14 @@ impl<'a, F: HitFilter<Hit>> TriangleLeaves<'a, F> {
         }
         false
     }
+}
+
+/// The scalar test's hit of `source` on lane `lane` of block `index` within
+/// `source.t_min..=t_max`, if any: how a lane the SIMD test leaves undecided is decided.
+#[inline(always)]
+pub(super) fn scalar_hit(blocks: &[TriBlock], source: &Ray, index: u32, lane: usize, t_max: f32) -> Option<Hit> {
+    let block = &blocks[index as usize];
+    TriRay::scalar(source, block, lane, t_max).map(|h| Hit { t: h.t, prim: block.ids[lane], u: h.u, v: h.v })
 }
 
 /// Keeps the hit on triangle `prim` in `best` if it is closer, or as close with a lower index

@@ -25,10 +25,9 @@ use super::node::{NodeRay, reach};
 use super::packet::PacketLeaves;
 use super::packet_kernels::{Lanes, PACKET, PacketRays};
 use super::packet_triangles::{PacketBest, PacketTriRays};
-use super::traverse::Leaves;
+use super::traverse::{Leaves, take_lowest};
 use super::triangle_bvh::TriangleBvh;
 use super::triangle_leaves;
-use super::triangles::TriRay;
 use crate::accel::{Counters, Hit, NoFilter};
 use crate::geom::prefetch::prefetch;
 
@@ -183,23 +182,28 @@ impl TrianglePacket<'_, WholePacket> {
         self.test.active
     }
 
+    /// The scalar hit of a noted pair, with its ray's index, if that ray is one of `rays` and not
+    /// asked again.
+    fn noted_hit(&self, (block, bit): (u32, u8), rays: u32) -> Option<(usize, Hit)> {
+        let (lane, i) = (bit as usize / PACKET, bit as usize % PACKET);
+        if (rays & !self.test.again) >> i & 1 == 0 {
+            return None;
+        }
+        let hit = triangle_leaves::scalar_hit(self.bvh.blocks(), &self.packet.ray(i), block, lane, self.best.t.0[i]);
+        hit.map(|hit| (i, hit))
+    }
+
     /// Decides the pairs the walk noted, and asks the rays that met too many again: each ray's
     /// closest hit is then its own query's.
     pub(super) fn settle_closest<C: Counters>(&mut self, counters: &mut C) {
-        let w = &self.test;
-        for &(block, bit) in &w.noted[..w.len] {
-            let (lane, i) = (bit as usize / PACKET, bit as usize % PACKET);
-            if w.again >> i & 1 == 0 {
-                let block = &self.bvh.blocks()[block as usize];
-                if let Some(h) = TriRay::scalar(&self.packet.ray(i), block, lane, self.best.t.0[i]) {
-                    self.best.offer(i, Hit { t: h.t, prim: block.ids[lane], u: h.u, v: h.v });
-                }
+        for k in 0..self.test.len {
+            if let Some((i, hit)) = self.noted_hit(self.test.noted[k], u32::MAX) {
+                self.best.offer(i, hit);
             }
         }
-        let mut again = w.again;
+        let mut again = self.test.again;
         while again != 0 {
-            let i = again.trailing_zeros() as usize;
-            again &= again - 1;
+            let i = take_lowest(&mut again);
             // The query's answer is the closest of every hit, so of those the walk found too.
             if let Some(hit) = self.bvh.closest_hit_of_valid(&self.packet.ray(i), counters, NoFilter) {
                 self.best.offer(i, hit);
@@ -211,21 +215,15 @@ impl TrianglePacket<'_, WholePacket> {
     /// for and does not ask again, those that hit one of the pairs it noted, and those asked
     /// again that hit anything.
     pub(super) fn settle_any<C: Counters>(&self, walked: u32, counters: &mut C) -> u32 {
-        let w = &self.test;
-        let mut found = walked & !w.again;
-        for &(block, bit) in &w.noted[..w.len] {
-            let (lane, i) = (bit as usize / PACKET, bit as usize % PACKET);
-            if (!found & !w.again) >> i & 1 != 0 {
-                let block = &self.bvh.blocks()[block as usize];
-                if TriRay::scalar(&self.packet.ray(i), block, lane, self.best.t.0[i]).is_some() {
-                    found |= 1 << i;
-                }
+        let mut found = walked & !self.test.again;
+        for &pair in &self.test.noted[..self.test.len] {
+            if let Some((i, _)) = self.noted_hit(pair, !found) {
+                found |= 1 << i;
             }
         }
-        let mut again = w.again;
+        let mut again = self.test.again;
         while again != 0 {
-            let i = again.trailing_zeros() as usize;
-            again &= again - 1;
+            let i = take_lowest(&mut again);
             if self.bvh.any_hit_of_valid(&self.packet.ray(i), counters, NoFilter) {
                 found |= 1 << i;
             }
@@ -288,6 +286,8 @@ impl LeafTest for WholePacket {
         // SAFETY: `WholePacket` is only made for structures whose instruction set is AVX-512,
         // which the processor has (see `Isa`).
         unsafe { leaves.test_blocks(first, count, rays, true, counters) };
+        // Every ray asked again (the packet gave up): its limits stay below zero, which ends
+        // the walk.
         if leaves.test.again == leaves.test.active {
             return;
         }
