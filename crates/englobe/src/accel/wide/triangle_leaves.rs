@@ -23,6 +23,7 @@
 //! closer. An any-hit walk that meets a hit it can decide needs no other.
 
 use std::cell::Cell;
+use std::mem::MaybeUninit;
 
 use super::traverse::Leaves;
 use super::triangles::{BlockHits, TriBlock, TriRay, UNUSED, intersect_block};
@@ -39,7 +40,7 @@ type Noted = (u32, u8);
 thread_local! {
     /// The list of the walks after a first one that met too many undecided lanes, reused from
     /// query to query. A query nested inside another's filter finds it taken and uses a fresh one.
-    static LONG_LIST: Cell<Vec<Noted>> = const { Cell::new(Vec::new()) };
+    static LONG_LIST: Cell<Vec<MaybeUninit<Noted>>> = const { Cell::new(Vec::new()) };
 }
 
 /// A query's view of the triangle blocks, its closest hit so far, the caller's filter, and the
@@ -51,8 +52,9 @@ pub(super) struct TriangleLeaves<'a, F> {
     best: Option<Hit>,
     t_max: f32,
     filter: F,
-    /// The list of undecided lanes, its first `min(met, list.len())` entries used.
-    list: &'a mut [Noted],
+    /// The list of undecided lanes, its first `min(met, list.len())` entries written; the rest
+    /// are left as they were (a query does not clear its list: most never note a lane).
+    list: &'a mut [MaybeUninit<Noted>],
     /// The undecided lanes met, noted or not.
     met: usize,
 }
@@ -67,7 +69,7 @@ pub(super) fn closest_hit<F: HitFilter<Hit>>(
     filter: F,
     mut walk: impl FnMut(&mut TriangleLeaves<'_, F>),
 ) -> Option<Hit> {
-    let mut list = [(0, 0); DEFERRED];
+    let mut list = [MaybeUninit::uninit(); DEFERRED];
     let mut leaves = TriangleLeaves::new(blocks, source, t_max, filter, &mut list);
     walk(&mut leaves);
     if leaves.met <= DEFERRED {
@@ -93,7 +95,7 @@ fn closest_hit_again<F: HitFilter<Hit>>(
     let mut list = LONG_LIST.with(Cell::take);
     loop {
         if list.len() < met {
-            list.resize(met, (0, 0));
+            list.resize(met, MaybeUninit::uninit());
         }
         let mut leaves = TriangleLeaves::new(blocks, source, t_max, filter, &mut list[..met]);
         leaves.best = best;
@@ -118,7 +120,7 @@ pub(super) fn any_hit<F: HitFilter<Hit>>(
     filter: F,
     mut walk: impl FnMut(&mut TriangleLeaves<'_, F>) -> bool,
 ) -> bool {
-    let mut list = [(0, 0); DEFERRED];
+    let mut list = [MaybeUninit::uninit(); DEFERRED];
     let mut leaves = TriangleLeaves::new(blocks, source, t_max, filter, &mut list);
     if walk(&mut leaves) {
         return true;
@@ -145,7 +147,7 @@ fn any_hit_again<F: HitFilter<Hit>>(
     let mut list = LONG_LIST.with(Cell::take);
     let hit = loop {
         if list.len() < met {
-            list.resize(met, (0, 0));
+            list.resize(met, MaybeUninit::uninit());
         }
         let mut leaves = TriangleLeaves::new(blocks, source, t_max, filter, &mut list[..met]);
         if walk(&mut leaves) {
@@ -165,7 +167,7 @@ impl<'a, F: HitFilter<Hit>> TriangleLeaves<'a, F> {
     /// The leaf tests of `source` in `blocks`, within `source.t_min..=t_max`, noting undecided
     /// lanes in `list`.
     #[inline(always)]
-    fn new(blocks: &'a [TriBlock], source: &'a Ray, t_max: f32, filter: F, list: &'a mut [Noted]) -> Self {
+    fn new(blocks: &'a [TriBlock], source: &'a Ray, t_max: f32, filter: F, list: &'a mut [MaybeUninit<Noted>]) -> Self {
         TriangleLeaves { blocks, source, best: None, t_max, filter, list, met: 0 }
     }
 
@@ -196,15 +198,19 @@ impl<'a, F: HitFilter<Hit>> TriangleLeaves<'a, F> {
                 continue;
             }
             if let Some(slot) = self.list.get_mut(self.met) {
-                *slot = (index as u32, lane as u8);
+                slot.write((index as u32, lane as u8));
             }
             self.met += 1;
         }
     }
 
-    /// The scalar test's hit of a noted lane within the interval, if any.
+    /// The scalar test's hit of noted lane `i` (below [`TriangleLeaves::noted`]) within the
+    /// interval, if any.
     #[inline(always)]
-    fn scalar_hit(&self, (index, lane): Noted) -> Option<Hit> {
+    fn scalar_hit(&self, i: usize) -> Option<Hit> {
+        assert!(i < self.noted());
+        // SAFETY: `defer` wrote every entry below `noted()`, in order, before counting it.
+        let (index, lane) = unsafe { self.list[i].assume_init() };
         scalar_hit(self.blocks, self.source, index, lane as usize, self.t_max)
     }
 
@@ -213,7 +219,7 @@ impl<'a, F: HitFilter<Hit>> TriangleLeaves<'a, F> {
     #[inline(never)]
     fn decide_closest(&mut self) {
         for i in 0..self.noted() {
-            if let Some(hit) = self.scalar_hit(self.list[i]) {
+            if let Some(hit) = self.scalar_hit(i) {
                 offer(&mut self.best, &mut self.t_max, &mut self.filter, hit);
             }
         }
@@ -224,7 +230,7 @@ impl<'a, F: HitFilter<Hit>> TriangleLeaves<'a, F> {
     #[inline(never)]
     fn decide_any(&mut self) -> bool {
         for i in 0..self.noted() {
-            if let Some(hit) = self.scalar_hit(self.list[i])
+            if let Some(hit) = self.scalar_hit(i)
                 && (F::ACCEPTS_ALL || self.filter.accept(&hit))
             {
                 return true;
