@@ -307,6 +307,36 @@ mod tests {
     }
 
     #[test]
+    fn lanes_agree_at_the_ends_of_the_interval() {
+        // Rays that start on a triangle, and rays whose interval begins or ends exactly where the
+        // scalar test hits (or one float past it), through vertices (the hit then lies on the
+        // triangle's box, where the box correction's widened far end decides) and inside points:
+        // anything a block test drops or keeps early must agree with the scalar test there.
+        let mut next = rng(0x51ab_2009);
+        let mut hits = 0;
+        for i in 0..20_000 {
+            let mut p = || Vec3::new(next(), next(), next()) * 2.0 - 1.0;
+            let tris: Vec<(u32, [Vec3; 3])> = (0..1 + i % 4).map(|k| (k as u32, [p(), p(), p()])).collect();
+            let dir = p();
+            let [a, b, c] = tris[0].1;
+            let (u, v) = (next() * 0.5, next() * 0.5);
+            let on = if i % 2 == 0 { [a, b, c][i / 2 % 3] } else { a + (b - a) * u + (c - a) * v };
+            hits += agree(&tris, &Ray::new(on, dir));
+            hits += agree(&tris, &Ray::new(on, -dir));
+            let origin = on - dir * 2.0;
+            let ray = Ray::new(origin, dir);
+            if let Some(h) = intersect_triangle(&ray, &WatertightRay::new(&ray), a, b, c) {
+                for (t_min, t_max) in
+                    [(0.0, h.t), (0.0, h.t.next_down()), (h.t, f32::INFINITY), (h.t.next_up(), f32::INFINITY)]
+                {
+                    hits += agree(&tris, &Ray::segment(origin, dir, t_min, t_max));
+                }
+            }
+        }
+        assert!(hits > 10_000, "{hits}");
+    }
+
+    #[test]
     fn lanes_agree_on_edges_vertices_and_axis_parallel_rays() {
         // A fan of triangles on an integer grid, with rays through its vertices and edges along
         // the axes and diagonals: edge functions of exactly zero, the scalar test's f64 path.
