@@ -269,6 +269,16 @@ mod tests {
         move || rng.random()
     }
 
+    /// A point of the cube `[-1, 1)^3`.
+    fn point(next: &mut impl FnMut() -> f32) -> Vec3 {
+        Vec3::new(next(), next(), next()) * 2.0 - 1.0
+    }
+
+    /// `n` random triangles in that cube, numbered from 0.
+    fn soup(next: &mut impl FnMut() -> f32, n: usize) -> Vec<(u32, [Vec3; 3])> {
+        (0..n).map(|k| (k as u32, [point(next), point(next), point(next)])).collect()
+    }
+
     /// The lanes against the scalar test, lane by lane, special lanes resolved by it.
     fn agree(tris: &[(u32, [Vec3; 3])], ray: &Ray) -> u32 {
         let block = TriBlock::new(tris);
@@ -296,10 +306,9 @@ mod tests {
         let mut next = rng(0x9e37_79b9);
         let mut hits = 0;
         for i in 0..20_000 {
-            let mut p = || Vec3::new(next(), next(), next()) * 2.0 - 1.0;
-            let tris: Vec<(u32, [Vec3; 3])> = (0..1 + i % 4).map(|k| (k as u32, [p(), p(), p()])).collect();
-            let origin = p() * 3.0;
-            let target = p() * 0.5;
+            let tris = soup(&mut next, 1 + i % 4);
+            let origin = point(&mut next) * 3.0;
+            let target = point(&mut next) * 0.5;
             let t_max = [f32::INFINITY, 2.0, 0.5][i % 3];
             hits += agree(&tris, &Ray::segment(origin, target - origin, 0.0, t_max));
         }
@@ -315,9 +324,8 @@ mod tests {
         let mut next = rng(0x51ab_2009);
         let mut hits = 0;
         for i in 0..20_000 {
-            let mut p = || Vec3::new(next(), next(), next()) * 2.0 - 1.0;
-            let tris: Vec<(u32, [Vec3; 3])> = (0..1 + i % 4).map(|k| (k as u32, [p(), p(), p()])).collect();
-            let dir = p();
+            let tris = soup(&mut next, 1 + i % 4);
+            let dir = point(&mut next);
             let [a, b, c] = tris[0].1;
             let (u, v) = (next() * 0.5, next() * 0.5);
             let on = if i % 2 == 0 { [a, b, c][i / 2 % 3] } else { a + (b - a) * u + (c - a) * v };
