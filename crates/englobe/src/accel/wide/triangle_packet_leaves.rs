@@ -80,8 +80,7 @@ impl<'a, T> TrianglePacket<'a, T> {
         let bvh = self.bvh;
         let mut found = 0;
         while rays != 0 {
-            let i = rays.trailing_zeros() as usize;
-            rays &= rays - 1;
+            let i = take_lowest(&mut rays);
             let source = &self.packet.ray(i);
             let node_ray = NodeRay::new(source);
             let (blocks, t_max) = (bvh.blocks(), self.best.t.0[i]);
@@ -292,8 +291,7 @@ impl LeafTest for WholePacket {
             return;
         }
         while rays != 0 {
-            let i = rays.trailing_zeros() as usize;
-            rays &= rays - 1;
+            let i = take_lowest(&mut rays);
             leaves.limits.0[i] = reach(leaves.best.t.0[i]);
         }
     }
@@ -323,8 +321,7 @@ impl LeafTest for RayByRay {
         // The rays' triangle constants are prepared at each leaf: only processors without
         // AVX-512 come here.
         while rays != 0 {
-            let i = rays.trailing_zeros() as usize;
-            rays &= rays - 1;
+            let i = take_lowest(&mut rays);
             let source = leaves.packet.ray(i);
             let t_max = leaves.best.t.0[i];
             let best = triangle_leaves::closest_hit(leaves.bvh.blocks(), &source, t_max, NoFilter, |lane| {
@@ -349,8 +346,7 @@ impl LeafTest for RayByRay {
     ) -> u32 {
         let mut found = 0;
         while rays != 0 {
-            let i = rays.trailing_zeros() as usize;
-            rays &= rays - 1;
+            let i = take_lowest(&mut rays);
             let source = leaves.packet.ray(i);
             if triangle_leaves::any_hit(leaves.bvh.blocks(), &source, leaves.best.t.0[i], NoFilter, |lane| {
                 let ray = Leaves::<C>::prepare(lane);
