@@ -24,7 +24,7 @@ use crate::shapes::WatertightRay;
 pub struct PacketTriRays {
     /// The origins' coordinates on the axes `kx`, `ky`, `kz`.
     origin_k: [Lanes; 3],
-    /// The shears `(d[kx] / d[kz], d[ky] / d[kz], 1 / d[kz])`.
+    /// The shears `(d[kx] / d[kz], d[ky] / d[kz], 1 / d[kz])`, made as [`WatertightRay::new`] makes them.
     shear: [Lanes; 3],
     axes: [usize; 3],
 }
@@ -79,11 +79,14 @@ impl PacketTriRays {
                 *dz = 1.0;
             }
         }
-        // The shear of `WatertightRay::new`, the same divisions lane by lane (one vector loop).
+        // The shear of `WatertightRay::new`, the same operations lane by lane (one vector loop):
+        // `1 / d[kz]` as the ray's inverse direction has it (`d[kz]`, the largest component, is
+        // not zero), and two products.
         for i in 0..PACKET {
-            p.shear[0].0[i] = dx[i] / dz[i];
-            p.shear[1].0[i] = dy[i] / dz[i];
-            p.shear[2].0[i] = 1.0 / dz[i];
+            let inv_z = 1.0 / dz[i];
+            p.shear[0].0[i] = dx[i] * inv_z;
+            p.shear[1].0[i] = dy[i] * inv_z;
+            p.shear[2].0[i] = inv_z;
         }
         p
     }

@@ -27,9 +27,9 @@ use std::mem::MaybeUninit;
 
 use super::traverse::Leaves;
 use super::triangles::{BlockHits, TriBlock, TriRay, UNUSED, intersect_block};
-use crate::Ray;
 use crate::accel::{Counters, Hit, HitFilter};
 use crate::geom::prefetch::prefetch;
+use crate::{PrimHit, Ray};
 
 /// The undecided lanes a query notes in its first walk.
 pub const DEFERRED: usize = 8;
@@ -177,9 +177,10 @@ impl<'a, F: HitFilter<Hit>> TriangleLeaves<'a, F> {
         self.met.min(self.list.len())
     }
 
-    /// `block` tested (its used lanes counted as exact tests) within the interval.
+    /// `block` tested (its used lanes counted as exact tests) within the interval: `None` if no
+    /// lane passed its edge tests.
     #[inline(always)]
-    fn test<C: Counters>(&self, block: &TriBlock, ray: &TriRay, counters: &mut C) -> BlockHits {
+    fn test<C: Counters>(&self, block: &TriBlock, ray: &TriRay, counters: &mut C) -> Option<BlockHits> {
         for _ in 0..block.used() {
             counters.exact_test();
         }
@@ -277,16 +278,14 @@ impl<C: Counters, F: HitFilter<Hit>> Leaves<C> for TriangleLeaves<'_, F> {
         let blocks = self.blocks;
         let first = first as usize;
         for (i, block) in blocks[first..first + count as usize].iter().enumerate() {
-            let hits = self.test(block, ray, counters);
-            if hits.hit | hits.special == 0 {
-                continue;
-            }
+            let Some(hits) = self.test(block, ray, counters) else { continue };
             let mut mask = hits.hit;
             while mask != 0 {
                 let lane = mask.trailing_zeros() as usize;
                 mask &= mask - 1;
                 if block.ids[lane] != UNUSED {
-                    let hit = Hit { t: hits.t[lane], prim: block.ids[lane], u: hits.u[lane], v: hits.v[lane] };
+                    let PrimHit { t, u, v } = hits.lane(lane);
+                    let hit = Hit { t, prim: block.ids[lane], u, v };
                     offer(&mut self.best, &mut self.t_max, &mut self.filter, hit);
                 }
             }
@@ -318,7 +317,7 @@ impl<C: Counters, F: HitFilter<Hit>> Leaves<C> for TriangleLeaves<'_, F> {
         let blocks = self.blocks;
         let first = first as usize;
         for (i, block) in blocks[first..first + count as usize].iter().enumerate() {
-            let hits = self.test(block, ray, counters);
+            let Some(hits) = self.test(block, ray, counters) else { continue };
             if F::ACCEPTS_ALL {
                 // An unused lane repeats a used one: its hit is that lane's.
                 if hits.hit != 0 {
@@ -329,7 +328,8 @@ impl<C: Counters, F: HitFilter<Hit>> Leaves<C> for TriangleLeaves<'_, F> {
                 while mask != 0 {
                     let lane = mask.trailing_zeros() as usize;
                     mask &= mask - 1;
-                    let hit = Hit { t: hits.t[lane], prim: block.ids[lane], u: hits.u[lane], v: hits.v[lane] };
+                    let PrimHit { t, u, v } = hits.lane(lane);
+                    let hit = Hit { t, prim: block.ids[lane], u, v };
                     if block.ids[lane] != UNUSED && self.filter.accept(&hit) {
                         return true;
                     }

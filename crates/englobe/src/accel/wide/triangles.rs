@@ -10,10 +10,11 @@
 //! The lanes compute exactly what the scalar test [`intersect_triangle`] computes, with the same
 //! operations in the same order (no fused multiply-add; only the box-stretch correction takes its
 //! three axes in another order, which cannot change its result, see [`intersect_block`]), so a
-//! lane hits if and only if the scalar test hits, at the same `t`. The scalar test's rare paths are not duplicated: a lane whose edge
-//! functions are not all normal numbers (zero, subnormal, infinite: a ray through an edge or a
-//! vertex, or a scene at an extreme scale) or whose `t` is not finite is reported as *special*,
-//! and the caller runs the scalar test on that triangle. Lanes whose edge functions have strictly
+//! lane hits if and only if the scalar test hits, at the same `t`. The scalar test's rare paths
+//! are not duplicated: a lane whose edge functions are not all normal numbers (zero, subnormal,
+//! infinite: a ray through an edge or a vertex, or a scene at an extreme scale), whose
+//! determinant (their sum) overflows or whose `t` is not finite is reported as *special*, and the
+//! caller runs the scalar test on that triangle. Lanes whose edge functions have strictly
 //! opposite signs are misses whatever the precision (rounding is monotonic, so a nonzero `f32`
 //! edge function has the sign of the exact one), which the scalar test's `f64` path would also
 //! conclude. Zero-area triangles are never stored: the scalar test never hits them.
@@ -93,6 +94,10 @@ pub struct TriRay {
     /// [`TriRay::row`] relies on to read a block without a bounds check).
     axes: [usize; 3],
     shear: [Vec4; 3],
+    /// The lanes of axis `kx, ky, kz` where the ray goes down it (`inv_dir < 0`, all of them or
+    /// none): where the box correction's near and far planes are a triangle's largest and
+    /// smallest coordinates.
+    down: [BVec4A; 3],
     t_min: Vec4,
 }
 
@@ -101,14 +106,17 @@ impl TriRay {
     #[inline(always)]
     pub fn new(ray: &Ray) -> Self {
         let watertight = WatertightRay::new(ray);
-        // Arrays, not vectors: `Vec3`'s index is a chain of comparisons per lookup.
-        let (o, inv, s) = (ray.origin().to_array(), ray.inv_dir().to_array(), watertight.shear());
+        // Four-entry arrays, not vectors: `Vec3`'s index is a chain of comparisons per lookup, and
+        // an axis (two bits) indexes four entries without a bounds check.
+        let (o, inv, s) =
+            (ray.origin_a().extend(0.0).to_array(), ray.inv_dir_a().extend(0.0).to_array(), watertight.shear());
         let axes = watertight.axes();
         TriRay {
             origin: axes.map(|a| Vec4::splat(o[a])),
             inv_dir: axes.map(|a| Vec4::splat(inv[a])),
             axes,
             shear: [0, 1, 2].map(|a| Vec4::splat(s[a])),
+            down: axes.map(|a| !Vec4::splat(inv[a]).cmpge(Vec4::ZERO)),
             t_min: Vec4::splat(ray.t_min),
         }
     }
@@ -134,7 +142,9 @@ impl TriRay {
     }
 }
 
-/// What the four lanes of a block gave.
+/// What the four lanes of a block gave. The distances and barycentrics stay vectors: a caller
+/// reads them lane by lane only for the lanes hit, so a block that nothing hits (most of them)
+/// writes nothing to memory (arrays indexed by a lane number would be stored on every return).
 #[derive(Clone, Copy, Debug)]
 pub struct BlockHits {
     /// Lanes hit within the interval (bit per lane).
@@ -142,16 +152,24 @@ pub struct BlockHits {
     /// Lanes the scalar test must decide.
     pub special: u32,
     /// Hit distance of each hit lane.
-    pub t: [f32; LANES],
+    t: Vec4,
     /// First barycentric of each hit lane.
-    pub u: [f32; LANES],
+    u: Vec4,
     /// Second barycentric of each hit lane.
-    pub v: [f32; LANES],
+    v: Vec4,
 }
 
 impl BlockHits {
     /// No lane hit and none special.
-    pub const NONE: BlockHits = BlockHits { hit: 0, special: 0, t: [0.0; 4], u: [0.0; 4], v: [0.0; 4] };
+    pub const NONE: BlockHits = BlockHits { hit: 0, special: 0, t: Vec4::ZERO, u: Vec4::ZERO, v: Vec4::ZERO };
+
+    /// The hit of lane `lane`, one of the lanes [`BlockHits::hit`] holds.
+    #[inline(always)]
+    pub fn lane(&self, lane: usize) -> PrimHit {
+        debug_assert!(self.hit >> lane & 1 != 0);
+        let (t, u, v) = (self.t.to_array(), self.u.to_array(), self.v.to_array());
+        PrimHit { t: t[lane], u: u[lane], v: v[lane] }
+    }
 }
 
 /// `if a > b { a } else { b }` per lane, as the scalar slab test: `b` when `a` is NaN, and when
@@ -177,17 +195,30 @@ fn keep_less(a: Vec4, b: Vec4) -> Vec4 {
     Vec4::select(a.cmplt(b), a, b)
 }
 
-/// Lanes holding normal numbers (not zero, subnormal, infinite or NaN), as `f32::is_normal`.
+/// `(lo, hi)`, the two swapped in the lanes of `swap`: `select(swap, hi, lo)` and
+/// `select(swap, lo, hi)` in four bit operations on x86-64 rather than six.
 #[inline(always)]
-fn normal(x: Vec4) -> BVec4A {
-    let a = x.abs();
-    a.cmpge(Vec4::splat(f32::MIN_POSITIVE)) & a.cmplt(Vec4::INFINITY)
+fn order(lo: Vec4, hi: Vec4, swap: BVec4A) -> (Vec4, Vec4) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::{_mm_and_ps, _mm_xor_ps};
+        // SAFETY: SSE is part of every x86-64 processor.
+        let (lo, hi) = unsafe {
+            let differ = _mm_and_ps(_mm_xor_ps(lo.into(), hi.into()), swap.into());
+            (_mm_xor_ps(lo.into(), differ), _mm_xor_ps(hi.into(), differ))
+        };
+        return (lo.into(), hi.into());
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    (Vec4::select(swap, hi, lo), Vec4::select(swap, lo, hi))
 }
 
 /// The watertight test of the ray against the four triangles of `block`, within
-/// `t_min..=t_max`. Every lane reports what [`intersect_triangle`] would, or is special.
+/// `t_min..=t_max`. Every lane reports what [`intersect_triangle`] would, or is special; `None`
+/// when the edge functions alone exclude every lane (most blocks), so that a caller's loop goes
+/// straight on to the next block.
 #[inline(always)]
-pub fn intersect_block(block: &TriBlock, r: &TriRay, t_max: f32) -> BlockHits {
+pub fn intersect_block(block: &TriBlock, r: &TriRay, t_max: f32) -> Option<BlockHits> {
     let [sx, sy, sz] = r.shear;
     // Vertex k relative to the origin, sheared: exactly the scalar test's `ax`, `ay`, `az`.
     let project = |k: usize| {
@@ -206,16 +237,23 @@ pub fn intersect_block(block: &TriBlock, r: &TriRay, t_max: f32) -> BlockHits {
     let positive = e0.cmpgt(zero) | e1.cmpgt(zero) | e2.cmpgt(zero);
     let inside = !(negative & positive);
     if !inside.any() {
-        return BlockHits::NONE;
+        return None;
     }
-    let all_normal = normal(e0) & normal(e1) & normal(e2);
-    let special = inside & !all_normal;
-    let candidate = inside & all_normal;
+    // The lanes whose edge functions are all normal numbers (as the scalar test asks) and whose
+    // determinant is finite. Inside its edges, a lane's edge functions have one sign, so the
+    // determinant is at least as large as each: an infinite or NaN one makes it infinite or NaN,
+    // and the smallest is the one to compare with the smallest normal number (a NaN that `min`
+    // passed over has made the determinant NaN already). A finite sum of normal numbers that
+    // overflows is left to the scalar test too.
+    let det = e0 + e1 + e2;
+    let smallest = e0.abs().min(e1.abs()).min(e2.abs());
+    let regular = smallest.cmpge(Vec4::splat(f32::MIN_POSITIVE)) & det.abs().cmplt(Vec4::INFINITY);
+    let special = inside & !regular;
+    let candidate = inside & regular;
     if !candidate.any() {
-        return BlockHits { special: special.bitmask(), ..BlockHits::NONE };
+        return Some(BlockHits { special: special.bitmask(), ..BlockHits::NONE });
     }
     let (az, bz, cz) = (sz * a_z, sz * b_z, sz * c_z);
-    let det = e0 + e1 + e2;
     let t_scaled = e0 * az + e1 * bz + e2 * cz;
     let inv_det = Vec4::ONE / det;
     let t = t_scaled * inv_det;
@@ -233,9 +271,7 @@ pub fn intersect_block(block: &TriBlock, r: &TriRay, t_max: f32) -> BlockHits {
         let (p, q, s) = (r.row(block, 0, axis), r.row(block, 1, axis), r.row(block, 2, axis));
         let (lo, hi) = (p.min(q).min(s), p.max(q).max(s));
         let inv = r.inv_dir[axis];
-        let positive_dir = inv.cmpge(zero);
-        let near = Vec4::select(positive_dir, lo, hi);
-        let far = Vec4::select(positive_dir, hi, lo);
+        let (near, far) = order(lo, hi, r.down[axis]);
         let t_near = (near - r.origin[axis]) * inv;
         let t_far = (far - r.origin[axis]) * inv * ROBUST_FAR_SCALE;
         enter = keep_greater(t_near, enter);
@@ -247,13 +283,7 @@ pub fn intersect_block(block: &TriBlock, r: &TriRay, t_max: f32) -> BlockHits {
     let t = keep_less(exit, t);
     let in_range = t.cmpge(r.t_min) & t.cmple(Vec4::splat(t_max));
     let hit = candidate & in_box & in_range;
-    BlockHits {
-        hit: hit.bitmask(),
-        special: special.bitmask(),
-        t: t.to_array(),
-        u: (e1 * inv_det).to_array(),
-        v: (e2 * inv_det).to_array(),
-    }
+    Some(BlockHits { hit: hit.bitmask(), special: special.bitmask(), t, u: e1 * inv_det, v: e2 * inv_det })
 }
 
 #[cfg(test)]
@@ -284,14 +314,14 @@ mod tests {
         let block = TriBlock::new(tris);
         let r = TriRay::new(ray);
         let w = WatertightRay::new(ray);
-        let got = intersect_block(&block, &r, ray.t_max);
+        let got = intersect_block(&block, &r, ray.t_max).unwrap_or(BlockHits::NONE);
         let mut hits = 0;
         for (lane, (_, [a, b, c])) in tris.iter().enumerate() {
             let expected = intersect_triangle(ray, &w, *a, *b, *c);
             let lane_hit = if got.special >> lane & 1 != 0 {
                 TriRay::scalar(ray, &block, lane, ray.t_max)
             } else if got.hit >> lane & 1 != 0 {
-                Some(PrimHit { t: got.t[lane], u: got.u[lane], v: got.v[lane] })
+                Some(got.lane(lane))
             } else {
                 None
             };
@@ -381,7 +411,7 @@ mod tests {
         assert_eq!(block.ids, [7, UNUSED, UNUSED, UNUSED]);
         assert_eq!(block.used(), 1);
         assert_eq!(block.vertices(3), t.1);
-        let hits = intersect_block(&block, &TriRay::new(&Ray::new(Vec3::new(0.2, 0.2, 1.0), -Vec3::Z)), 10.0);
+        let hits = intersect_block(&block, &TriRay::new(&Ray::new(Vec3::new(0.2, 0.2, 1.0), -Vec3::Z)), 10.0).unwrap();
         assert_eq!(hits.hit, 0b1111);
         assert!(!is_storable(&[Vec3::ZERO, Vec3::X, Vec3::X * 2.0]) && is_storable(&t.1));
     }
