@@ -199,16 +199,13 @@ fn keep_less(a: Vec4, b: Vec4) -> Vec4 {
 /// `select(swap, lo, hi)` in four bit operations on x86-64 rather than six.
 #[inline(always)]
 fn order(lo: Vec4, hi: Vec4, swap: BVec4A) -> (Vec4, Vec4) {
+    // SAFETY: SSE is part of every x86-64 processor.
     #[cfg(target_arch = "x86_64")]
-    {
+    return unsafe {
         use std::arch::x86_64::{_mm_and_ps, _mm_xor_ps};
-        // SAFETY: SSE is part of every x86-64 processor.
-        let (lo, hi) = unsafe {
-            let differ = _mm_and_ps(_mm_xor_ps(lo.into(), hi.into()), swap.into());
-            (_mm_xor_ps(lo.into(), differ), _mm_xor_ps(hi.into(), differ))
-        };
-        return (lo.into(), hi.into());
-    }
+        let differ = _mm_and_ps(_mm_xor_ps(lo.into(), hi.into()), swap.into());
+        (_mm_xor_ps(lo.into(), differ).into(), _mm_xor_ps(hi.into(), differ).into())
+    };
     #[cfg(not(target_arch = "x86_64"))]
     (Vec4::select(swap, hi, lo), Vec4::select(swap, lo, hi))
 }
