@@ -56,21 +56,14 @@ pub struct WatertightRay {
 }
 
 impl WatertightRay {
-    /// The constants for `ray`. The shear is made with the ray's inverse direction along `kz`
-    /// (`1 / d[kz]`, the largest component's, never zero for a ray that can hit) and two
-    /// products, rather than three divisions: a set-up that every query with a triangle test
-    /// waits for. Any per-ray constants keep the test watertight (the edge functions of two
-    /// triangles sharing an edge are computed from the same projected vertices); these differ
-    /// from the quotients by a rounding.
+    /// The constants for `ray`.
     #[inline(always)]
     pub fn new(ray: &Ray) -> Self {
         let d = ray.dir();
         let [kx, ky, kz] = Self::axes_of(d);
-        // Four-entry arrays, not the vectors: `Vec3`'s index is a chain of comparisons per lookup,
-        // and an axis (two bits) indexes four entries without a bounds check.
-        let d = ray.dir_a().extend(0.0).to_array();
-        let inv_z = ray.inv_dir_a().extend(0.0).to_array()[kz];
-        let shear = Vec3::new(d[kx] * inv_z, d[ky] * inv_z, inv_z);
+        // An array, not the vector: `Vec3`'s index is a chain of comparisons per lookup.
+        let d = d.to_array();
+        let shear = Vec3::new(d[kx] / d[kz], d[ky] / d[kz], 1.0 / d[kz]);
         WatertightRay { kx, ky, kz, shear }
     }
 
@@ -107,8 +100,7 @@ impl WatertightRay {
         [self.kx, self.ky, self.kz]
     }
 
-    /// The shear `(d[kx] / d[kz], d[ky] / d[kz], 1 / d[kz])`, as `d[kx] * (1 / d[kz])` and
-    /// `d[ky] * (1 / d[kz])`.
+    /// The shear `(d[kx] / d[kz], d[ky] / d[kz], 1 / d[kz])`.
     #[inline(always)]
     pub fn shear(&self) -> Vec3 {
         self.shear

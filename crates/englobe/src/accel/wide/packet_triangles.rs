@@ -24,7 +24,7 @@ use crate::shapes::WatertightRay;
 pub struct PacketTriRays {
     /// The origins' coordinates on the axes `kx`, `ky`, `kz`.
     origin_k: [Lanes; 3],
-    /// The shears `(d[kx] / d[kz], d[ky] / d[kz], 1 / d[kz])`, made as [`WatertightRay::new`] makes them.
+    /// The shears `(d[kx] / d[kz], d[ky] / d[kz], 1 / d[kz])`.
     shear: [Lanes; 3],
     axes: [usize; 3],
 }
@@ -79,14 +79,11 @@ impl PacketTriRays {
                 *dz = 1.0;
             }
         }
-        // The shear of `WatertightRay::new`, the same operations lane by lane (one vector loop):
-        // `1 / d[kz]` as the ray's inverse direction has it (`d[kz]`, the largest component, is
-        // not zero), and two products.
+        // The shear of `WatertightRay::new`, the same divisions lane by lane (one vector loop).
         for i in 0..PACKET {
-            let inv_z = 1.0 / dz[i];
-            p.shear[0].0[i] = dx[i] * inv_z;
-            p.shear[1].0[i] = dy[i] * inv_z;
-            p.shear[2].0[i] = inv_z;
+            p.shear[0].0[i] = dx[i] / dz[i];
+            p.shear[1].0[i] = dy[i] / dz[i];
+            p.shear[2].0[i] = 1.0 / dz[i];
         }
         p
     }
