@@ -7,7 +7,7 @@
 //! [`Isa::is_available`], so an arm is only ever taken on a processor that can run it.
 
 use super::isa::Isa;
-use super::kernels::Portable;
+use super::kernels::{NodeKernel, Portable};
 use super::node::{NodeRay, WideNode};
 use super::packet::{self, PacketLeaves};
 use super::packet_kernels::{PacketRays, ScalarPacket};
@@ -184,11 +184,50 @@ pub fn packet_query<Q: PacketQuery>(isa: Isa, query: Q) -> Q::Output {
     }
 }
 
+/// A whole single-ray query, from the caller's ray to the answer: compiled by [`ray_query`] with
+/// the structure's instruction set and walked with that set's node kernel, so that the query's
+/// set-up (the root's box, the node test's constants, the leaves' state) is made in the same
+/// function as the walk and stays in its registers instead of being handed over in memory.
+pub trait RayQuery {
+    /// What the query returns.
+    type Output;
+    /// Runs the query with `kernel`. Implementations are `#[inline(always)]`, so that their body
+    /// is compiled into the copy that calls them.
+    ///
+    /// # Safety
+    /// As [`NodeKernel::children`]: compiled with the kernel's target features, run on a processor
+    /// that has them.
+    unsafe fn run<K: NodeKernel>(self, kernel: K) -> Self::Output;
+}
+
+/// Runs `query` compiled for `isa`, which the processor must have (see the module documentation).
+#[inline(always)]
+pub fn ray_query<Q: RayQuery>(isa: Isa, query: Q) -> Q::Output {
+    debug_assert!(isa.is_available());
+    match isa {
+        Isa::Portable => portable::ray_query(query),
+        // SAFETY: the structure's instruction set is one the processor has (module documentation).
+        #[cfg(target_arch = "x86_64")]
+        Isa::Avx2 => unsafe { x86::ray_query_avx2(query) },
+        // SAFETY: as above.
+        #[cfg(target_arch = "x86_64")]
+        Isa::Avx512 => unsafe { x86::ray_query_avx512(query) },
+        #[cfg(not(target_arch = "x86_64"))]
+        _ => unreachable!("x86 instruction sets are never available elsewhere"),
+    }
+}
+
 /// The portable copies, compiled apart like the others rather than inlined into every caller:
 /// inlined, their code and stack would weigh on the caller's registers and frame on machines that
 /// run another copy.
 mod portable {
     use super::*;
+
+    #[inline(never)]
+    pub fn ray_query<Q: RayQuery>(query: Q) -> Q::Output {
+        // SAFETY: the portable kernel needs nothing beyond the target's baseline.
+        unsafe { query.run(Portable) }
+    }
 
     #[inline(never)]
     pub fn closest<C: Counters, L: Leaves<C>>(
@@ -260,6 +299,22 @@ mod x86 {
     #[target_feature(enable = "avx2,fma,bmi1,bmi2,lzcnt,popcnt,avx512f,avx512vl,avx512bw,avx512dq")]
     pub unsafe fn packet_query_avx512<Q: PacketQuery>(query: Q) -> Q::Output {
         query.run()
+    }
+
+    /// # Safety
+    /// The processor has AVX2, FMA and the bit instructions that come with them (see `Isa`).
+    #[target_feature(enable = "avx2,fma,bmi1,bmi2,lzcnt,popcnt")]
+    pub unsafe fn ray_query_avx2<Q: RayQuery>(query: Q) -> Q::Output {
+        // SAFETY: compiled with AVX2, which the caller guarantees.
+        unsafe { query.run(Avx2) }
+    }
+
+    /// # Safety
+    /// The processor has AVX-512 F, VL, BW and DQ (and AVX2).
+    #[target_feature(enable = "avx2,fma,bmi1,bmi2,lzcnt,popcnt,avx512f,avx512vl,avx512bw,avx512dq")]
+    pub unsafe fn ray_query_avx512<Q: RayQuery>(query: Q) -> Q::Output {
+        // SAFETY: compiled with AVX-512, which the caller guarantees.
+        unsafe { query.run(Avx512) }
     }
 
     /// # Safety

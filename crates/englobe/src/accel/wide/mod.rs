@@ -64,6 +64,7 @@ pub mod triangle_bvh;
 mod triangle_leaves;
 pub mod triangle_packet;
 mod triangle_packet_leaves;
+mod triangle_query;
 pub mod triangles;
 pub mod validate;
 

@@ -16,6 +16,7 @@ use super::isa::{Isa, IsaUnavailable};
 use super::node::{NodeRay, WideNode, may_enter, reach};
 use super::presplit::{TriangleBox, presplit_cuts};
 use super::triangle_leaves;
+use super::triangle_query;
 use super::triangles::{LANES, TriBlock, UNUSED, is_storable};
 use crate::accel::bvh::BinnedSah;
 use crate::accel::bvh::build::parallel::{collect_indexed, collect_indexed_huge, map_chunks};
@@ -385,10 +386,9 @@ impl TriangleBvh {
         if !self.may_enter(ray) {
             return false;
         }
-        let node_ray = NodeRay::new(ray);
-        triangle_leaves::any_hit(&self.blocks, ray, ray.t_max, filter, |leaves| {
-            dispatch::any(self.isa, &self.nodes, self.depth, 0, &node_ray, reach(ray.t_max), leaves, counters)
-        })
+        // The walk compiled into the query (see `triangle_query`); the closest-hit walk stays a
+        // call of its own, as the module there says why.
+        dispatch::ray_query(self.isa, triangle_query::Any { bvh: self, ray, counters, filter })
     }
 
     /// Whether `ray` may reach the tree: its origin inside the tree's box (then the root's test

@@ -110,6 +110,31 @@ fn closest_hit_again<F: HitFilter<Hit>>(
     best
 }
 
+/// An any-hit walk of the tree for [`any_hit_with`]: one that ends with [`Leaves::settle_any`].
+/// A trait rather than a closure, so that a walk compiled with the caller's instruction set can
+/// be inlined into it (a closure's body is compiled without the caller's `#[target_feature]`s, see
+/// [`super::traverse`]): how [`super::triangle_query`] walks.
+pub(super) trait AnyWalk<F> {
+    /// Whether the walk finds a hit.
+    fn walk(&mut self, leaves: &mut TriangleLeaves<'_, F>) -> bool;
+    /// The same walk, made again by [`any_hit_again`], a function compiled apart from the one that
+    /// made the first: a walk inlined into its caller has it call a compiled copy instead.
+    #[inline(always)]
+    fn walk_again(&mut self, leaves: &mut TriangleLeaves<'_, F>) -> bool {
+        self.walk(leaves)
+    }
+}
+
+/// A closure as an [`AnyWalk`].
+struct Closure<W>(W);
+
+impl<F, W: FnMut(&mut TriangleLeaves<'_, F>) -> bool> AnyWalk<F> for Closure<W> {
+    #[inline(always)]
+    fn walk(&mut self, leaves: &mut TriangleLeaves<'_, F>) -> bool {
+        (self.0)(leaves)
+    }
+}
+
 /// Whether `source` hits one of `blocks` within `source.t_min..=t_max`, the hit accepted by
 /// `filter`, as `walk` finds it (a walk of the tree that ends with [`Leaves::settle_any`]).
 #[inline(always)]
@@ -118,18 +143,30 @@ pub(super) fn any_hit<F: HitFilter<Hit>>(
     source: &Ray,
     t_max: f32,
     filter: F,
-    mut walk: impl FnMut(&mut TriangleLeaves<'_, F>) -> bool,
+    walk: impl FnMut(&mut TriangleLeaves<'_, F>) -> bool,
+) -> bool {
+    any_hit_with(blocks, source, t_max, filter, &mut Closure(walk))
+}
+
+/// [`any_hit`] with the walk an [`AnyWalk`].
+#[inline(always)]
+pub(super) fn any_hit_with<F: HitFilter<Hit>>(
+    blocks: &[TriBlock],
+    source: &Ray,
+    t_max: f32,
+    filter: F,
+    walk: &mut impl AnyWalk<F>,
 ) -> bool {
     let mut list = [MaybeUninit::uninit(); DEFERRED];
     let mut leaves = TriangleLeaves::new(blocks, source, t_max, filter, &mut list);
-    if walk(&mut leaves) {
+    if walk.walk(&mut leaves) {
         return true;
     }
     if leaves.met <= DEFERRED {
         return false;
     }
     let TriangleLeaves { filter, met, .. } = leaves;
-    any_hit_again(blocks, source, t_max, filter, met, &mut walk)
+    any_hit_again(blocks, source, t_max, filter, met, walk)
 }
 
 /// The walks that follow an any-hit walk that found no hit and met `met` undecided lanes, more
@@ -142,7 +179,7 @@ fn any_hit_again<F: HitFilter<Hit>>(
     t_max: f32,
     mut filter: F,
     mut met: usize,
-    walk: &mut impl FnMut(&mut TriangleLeaves<'_, F>) -> bool,
+    walk: &mut impl AnyWalk<F>,
 ) -> bool {
     let mut list = LONG_LIST.with(Cell::take);
     let hit = loop {
@@ -150,7 +187,7 @@ fn any_hit_again<F: HitFilter<Hit>>(
             list.resize(met, MaybeUninit::uninit());
         }
         let mut leaves = TriangleLeaves::new(blocks, source, t_max, filter, &mut list[..met]);
-        if walk(&mut leaves) {
+        if walk.walk_again(&mut leaves) {
             break true;
         }
         let room = met;
