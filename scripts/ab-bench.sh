@@ -1,0 +1,106 @@
+#!/usr/bin/env bash
+# Two revisions of englobe timed against each other on single rays, as fairly as a shared machine
+# allows: each revision is built several times with its loops placed differently, and the
+# binaries are run in turn, round after round, so that neither code placement (which moves a
+# single-ray timing by 5 % and more on some processors, with the same instructions: see
+# docs/performance.md) nor the machine's other work favours one of them.
+#
+#   scripts/ab-bench.sh REV_A REV_B [ROUNDS]
+#
+# REV_A and REV_B are git revisions (a commit, a branch, HEAD~1). Each is checked out under
+# target/ab-bench/ and its harness built once per placement: the compiler's own, then with every
+# loop aligned to each of ALIGNS bytes (`-C llvm-args=-align-loops=N` on the harness crate, where
+# the walks are compiled, being generic). Then ROUNDS rounds (default 5), each running every
+# binary once, A and B alternately first: one thread, the cells CELLS, RAYS rays, on SCENES.
+#
+# Prints, per cell, the median rays per second of each revision over all its runs, and B/A for
+# each placement (medians over the rounds) with their median: a change is worth as much as what
+# it gains under every placement, not under one. The runs' CSVs stay in target/ab-bench/runs/;
+# the binaries in target/ab-bench/bin/, by commit and placement, for the next comparison.
+#
+# Environment (defaults in brackets): ALIGNS ["32 64"], CELLS
+# [primary-closest,random-closest,random-any,bounce-closest], RAYS [500000], RESOLUTION [512],
+# REPS [5], ENGLOBE_SHARED [../shared], SCENES [the bunny, the ogre and the Sponza seen from
+# inside, as harness arguments].
+set -euo pipefail
+cd "$(dirname "$0")/.."
+[[ $# -ge 2 ]] || { sed -n '8,8s/^# \{0,1\}//p' "$0" >&2; exit 2; }
+rounds=${3:-5}
+aligns=(default ${ALIGNS-32 64})
+cells=${CELLS:-primary-closest,random-closest,random-any,bounce-closest}
+meshes=${ENGLOBE_SHARED:-../shared}/scenes/meshes
+if [[ -n ${SCENES:-} ]]; then
+    read -r -a scenes <<< "$SCENES"
+else
+    scenes=("bunny=$meshes/bunny/stanford-bunny.obj" "ogre=$meshes/ogre/ogre.obj"
+        "sponza-inside=$meshes/sponza-dabrovic/sponza.obj"
+        --view "sponza-inside=-10.43876,7.37331,0.00149,1,0,0,60")
+fi
+root=$(pwd)
+work=$root/target/ab-bench
+mkdir -p "$work/bin"
+rm -rf "$work/runs"
+mkdir -p "$work/runs"
+
+# Builds revision $2 as side $1 ("A" or "B"), once per placement, unless an earlier run did:
+# the binaries are kept under target/ab-bench/bin/, named by commit and placement.
+build() {
+    local side=$1 sha
+    sha=$(git rev-parse --verify "$2^{commit}")
+    local src=$work/src-$side
+    rm -rf "$src"
+    git worktree prune
+    for align in "${aligns[@]}"; do
+        local bin=$work/bin/$sha-$align
+        if [[ ! -x $bin ]]; then
+            [[ -d $src ]] || git worktree add --detach --quiet "$src" "$sha"
+            local flags=()
+            [[ $align == default ]] || flags=(-C "llvm-args=-align-loops=$align")
+            echo "building $side ($2, ${sha:0:10}), loops aligned: $align" >&2
+            (cd "$src" && CARGO_TARGET_DIR=$work/target-$side cargo rustc --quiet --release -p englobe-bench \
+                --bin englobe-bench -- "${flags[@]}")
+            cp "$work/target-$side/release/englobe-bench" "$bin.tmp"
+            mv "$bin.tmp" "$bin"
+        fi
+        ln -sf "$bin" "$work/run-$side-$align"
+    done
+    [[ ! -d $src ]] || git worktree remove --force "$src"
+}
+build A "$1"
+build B "$2"
+
+for round in $(seq 1 "$rounds"); do
+    order=(A B)
+    ((round % 2 == 0)) && order=(B A)
+    for align in "${aligns[@]}"; do
+        for side in "${order[@]}"; do
+            "$work/run-$side-$align" --threads 1 --reps "${REPS:-5}" --build-reps 1 --no-check --quiet \
+                --libraries englobe --cells "$cells" --rays "${RAYS:-500000}" --resolution "${RESOLUTION:-512}" \
+                --csv "$work/runs/$side-$align-$round.csv" "${scenes[@]}" > /dev/null
+        done
+    done
+    echo "round $round of $rounds done" >&2
+done
+
+echo "A: $1 ($(git rev-parse --short "$1")), B: $2 ($(git rev-parse --short "$2")); $rounds rounds, one thread"
+python3 - "$work/runs" "${aligns[@]}" <<'EOF'
+import csv, pathlib, statistics, sys
+from collections import defaultdict
+
+runs, aligns = pathlib.Path(sys.argv[1]), sys.argv[2:]
+rates = defaultdict(list)  # (cell, side, align) -> rays per second of each round
+for path in sorted(runs.glob("*.csv")):
+    side, align, _ = path.stem.split("-")
+    for row in csv.DictReader(path.open()):
+        if row["rays"] != "build":
+            cell = f'{row["scene"]} {row["rays"]} {row["query"]}'
+            rates[cell, side, align].append(float(row["mrays_per_s"]))
+cells = sorted({cell for cell, _, _ in rates})
+head = f'{"cell":32} {"A Mrays/s":>10} {"B Mrays/s":>10}' + "".join(f' {"B/A " + a:>11}' for a in aligns)
+print(head + f' {"median":>7}')
+for cell in cells:
+    every = {s: [r for a in aligns for r in rates[cell, s, a]] for s in "AB"}
+    ratios = [statistics.median(rates[cell, "B", a]) / statistics.median(rates[cell, "A", a]) for a in aligns]
+    line = f"{cell:32} {statistics.median(every['A']):10.3f} {statistics.median(every['B']):10.3f}"
+    print(line + "".join(f" {r:11.3f}" for r in ratios) + f" {statistics.median(ratios):7.3f}")
+EOF
