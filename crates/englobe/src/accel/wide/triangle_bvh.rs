@@ -16,7 +16,6 @@ use super::isa::{Isa, IsaUnavailable};
 use super::node::{NodeRay, WideNode, may_enter, reach};
 use super::presplit::{TriangleBox, presplit_cuts};
 use super::triangle_leaves;
-use super::triangle_query;
 use super::triangles::{LANES, TriBlock, UNUSED, is_storable};
 use crate::accel::bvh::BinnedSah;
 use crate::accel::bvh::build::parallel::{collect_indexed, collect_indexed_huge, map_chunks};
@@ -369,34 +368,12 @@ impl TriangleBvh {
         ray.is_valid() && self.any_hit_of_valid(ray, counters, filter)
     }
 
-    /// [`TriangleBvh::any_hit_filtered`] of a ray the caller checked with [`Ray::is_valid`].
-    #[inline]
-    pub(crate) fn any_hit_of_valid<C: Counters, F: HitFilter<Hit>>(
-        &self,
-        ray: &Ray,
-        counters: &mut C,
-        filter: F,
-    ) -> bool {
-        debug_assert!(ray.is_valid());
-        if self.nodes.is_empty() {
-            return false;
-        }
-        // The root's box first: a ray that passes beside it costs no more.
-        counters.box_tests(1);
-        if !self.may_enter(ray) {
-            return false;
-        }
-        // The walk compiled into the query (see `triangle_query`); the closest-hit walk stays a
-        // call of its own, as the module there says why.
-        dispatch::ray_query(self.isa, triangle_query::Any { bvh: self, ray, counters, filter })
-    }
-
     /// Whether `ray` may reach the tree: its origin inside the tree's box (then the root's test
     /// decides, at no extra cost: the rays of a scene seen from inside, shadow rays and bounces
     /// start there), or its slab test of the box ([`may_enter`]) passed. Never no where a node
     /// test would say yes.
     #[inline(always)]
-    fn may_enter(&self, ray: &Ray) -> bool {
+    pub(super) fn may_enter(&self, ray: &Ray) -> bool {
         self.bounds.contains_point(ray.origin_a()) || may_enter(&self.bounds, ray, reach(ray.t_max))
     }
 

@@ -3,8 +3,9 @@
 //! function, where the walk used to be a call of its own, handed its ray constants and its leaves'
 //! state in memory by the query around it, which then made its own constants again (the call had
 //! taken every vector register). About 30 fewer instructions per random any-hit ray (4-5 %), and
-//! 0.6-1.3 % faster under each of three code placements (`scripts/ab-bench.sh`, see
-//! `docs/performance.md`).
+//! 1.0-1.6 % faster, under each of three code placements (`scripts/ab-bench.sh`, see
+//! `docs/performance.md`). The query's own methods ([`TriangleBvh::any_hit_filtered`]) check the
+//! ray; `any_hit_of_valid` here tests the root's box and runs the rest.
 //!
 //! The closest-hit query stays a call of the walk ([`dispatch::closest`]): compiled whole the same
 //! way, it ran 25-35 more instructions per ray and 0-4.5 % slower, the compiler making the node
@@ -20,13 +21,35 @@ use super::triangle_leaves::{self, AnyWalk, TriangleLeaves};
 use crate::Ray;
 use crate::accel::{Counters, Hit, HitFilter};
 
+impl TriangleBvh {
+    /// [`TriangleBvh::any_hit_filtered`] of a ray the caller checked with [`Ray::is_valid`].
+    #[inline]
+    pub(crate) fn any_hit_of_valid<C: Counters, F: HitFilter<Hit>>(
+        &self,
+        ray: &Ray,
+        counters: &mut C,
+        filter: F,
+    ) -> bool {
+        debug_assert!(ray.is_valid());
+        if self.nodes().is_empty() {
+            return false;
+        }
+        // The root's box first: a ray that passes beside it costs no more.
+        counters.box_tests(1);
+        if !self.may_enter(ray) {
+            return false;
+        }
+        dispatch::ray_query(self.isa(), Any { bvh: self, ray, counters, filter })
+    }
+}
+
 /// Whether a valid ray hits a triangle whose hit `filter` accepts
 /// ([`TriangleBvh::any_hit_filtered`]).
-pub(super) struct Any<'a, C, F> {
-    pub bvh: &'a TriangleBvh,
-    pub ray: &'a Ray,
-    pub counters: &'a mut C,
-    pub filter: F,
+struct Any<'a, C, F> {
+    bvh: &'a TriangleBvh,
+    ray: &'a Ray,
+    counters: &'a mut C,
+    filter: F,
 }
 
 impl<C: Counters, F: HitFilter<Hit>> RayQuery for Any<'_, C, F> {
