@@ -19,7 +19,7 @@ Where `docs/performance.md` takes its per-instruction figures from, for example:
         --libraries englobe --cells random-any --rays 100000 --resolution 128 \\
         sponza-inside=../shared/scenes/meshes/sponza-dabrovic/sponza.obj \\
         --view "sponza-inside=-10.43876,7.37331,0.00149,1,0,0,60"
-    scripts/annotate-instructions.py any.out x86::any_avx2 400000
+    scripts/annotate-instructions.py any.out x86::ray_query_avx2 400000
 
 (with the harness built for `-C target-cpu=x86-64-v3`: valgrind cannot run AVX-512).
 """
