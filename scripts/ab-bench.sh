@@ -57,9 +57,10 @@ build() {
             local flags=()
             [[ $align == default ]] || flags=(-C "llvm-args=-align-loops=$align")
             echo "building $side ($2, ${sha:0:10}), loops aligned: $align" >&2
-            (cd "$src" && CARGO_TARGET_DIR=$work/target-$side cargo rustc --quiet --release -p englobe-bench \
+            # One target folder for both sides: the dependencies are built once.
+            (cd "$src" && CARGO_TARGET_DIR=$work/target cargo rustc --quiet --release -p englobe-bench \
                 --bin englobe-bench -- "${flags[@]}")
-            cp "$work/target-$side/release/englobe-bench" "$bin.tmp"
+            cp "$work/target/release/englobe-bench" "$bin.tmp"
             mv "$bin.tmp" "$bin"
         fi
         ln -sf "$bin" "$work/run-$side-$align"
