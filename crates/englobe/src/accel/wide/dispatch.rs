@@ -184,10 +184,10 @@ pub fn packet_query<Q: PacketQuery>(isa: Isa, query: Q) -> Q::Output {
     }
 }
 
-/// A whole single-ray query, from the caller's ray to the answer: compiled by [`ray_query`] with
-/// the structure's instruction set and walked with that set's node kernel, so that the query's
-/// set-up (the root's box, the node test's constants, the leaves' state) is made in the same
-/// function as the walk and stays in its registers instead of being handed over in memory.
+/// A single-ray query from a ray that may enter the tree to the answer: compiled by [`ray_query`]
+/// with the structure's instruction set and walked with that set's node kernel, so that its
+/// set-up (the node test's constants, the leaves' state) is made in the same function as the walk
+/// instead of being handed over to it in memory.
 pub trait RayQuery {
     /// What the query returns.
     type Output;

@@ -65,7 +65,7 @@ impl<C: Counters, F: HitFilter<Hit>> RayQuery for Any<'_, C, F> {
     }
 }
 
-/// A walk of the whole tree with `kernel`, compiled into the query that makes it.
+/// An any-hit walk of the whole tree with `kernel`, compiled into the query that makes it.
 struct TreeWalk<'a, K, C> {
     kernel: K,
     isa: Isa,
@@ -100,7 +100,8 @@ impl<'a, K: NodeKernel, C: Counters> TreeWalk<'a, K, C> {
 impl<F: HitFilter<Hit>, K: NodeKernel, C: Counters> AnyWalk<F> for TreeWalk<'_, K, C> {
     #[inline(always)]
     fn walk(&mut self, leaves: &mut TriangleLeaves<'_, F>) -> bool {
-        // SAFETY: as above.
+        // SAFETY: `TreeWalk::new`'s guarantee; the tree's interior references index its nodes,
+        // as the builders make them.
         unsafe { traverse::any(self.kernel, self.nodes, self.depth, 0, &self.ray, self.limit, leaves, self.counters) }
     }
 
