@@ -45,6 +45,19 @@ impl Triangle {
     }
 }
 
+/// The six orders `[kx, ky, kz]` [`WatertightRay::axes_of`] chooses from, two bits per axis, six
+/// bits per order, in the order of [`WatertightRay::axes_code`]: a shift instead of a load.
+const AXES: u64 = pack([1, 2, 0])
+    | pack([2, 1, 0]) << 6
+    | pack([2, 0, 1]) << 12
+    | pack([0, 2, 1]) << 18
+    | pack([0, 1, 2]) << 24
+    | pack([1, 0, 2]) << 30;
+
+const fn pack(axes: [u64; 3]) -> u64 {
+    axes[0] | axes[1] << 2 | axes[2] << 4
+}
+
 /// The per-ray constants of the watertight test: the axis the ray runs along (`kz`), the two
 /// others (`kx`, `ky`, swapped to keep the winding), and the shear that maps the ray onto +z.
 #[derive(Clone, Copy, Debug)]
@@ -56,6 +69,10 @@ pub struct WatertightRay {
 }
 
 impl WatertightRay {
+    /// The six orders of axes (see [`WatertightRay::axes_code`]), two bits per axis, six bits
+    /// per order, for code that unpacks them in its own form.
+    pub(crate) const AXES: u64 = AXES;
+
     /// The constants for `ray`.
     #[inline(always)]
     pub fn new(ray: &Ray) -> Self {
@@ -71,6 +88,14 @@ impl WatertightRay {
     /// the shear.
     #[inline(always)]
     pub fn axes_of(d: Vec3) -> [usize; 3] {
+        let bits = AXES >> (6 * Self::axes_code(d));
+        [(bits & 3) as usize, (bits >> 2 & 3) as usize, (bits >> 4 & 3) as usize]
+    }
+
+    /// Which of the six orders [`WatertightRay::axes_of`] gives for a ray of direction `d`:
+    /// `2 * kz + down`, `down` being 1 if the ray goes down `kz`.
+    #[inline(always)]
+    pub fn axes_code(d: Vec3) -> u32 {
         // `kz` is the axis of the largest component (the first of equal ones); `kx, ky` follow it
         // cyclically, swapped if the ray goes down `kz` so that the triangles' winding is kept.
         // Computed without branches: the axis of a random ray is a coin toss that a branch
@@ -79,19 +104,7 @@ impl WatertightRay {
         let x_largest = (a.x >= a.y) & (a.x >= a.z);
         let kz = (!x_largest as u32) * (1 + !(a.y >= a.z) as u32);
         let down = d.cmplt(Vec3::ZERO).bitmask() >> kz & 1;
-        // The six answers, `[kx, ky, kz]` in two bits each, six bits apiece, in the order
-        // `2 * kz + down`: a shift instead of a load.
-        const AXES: u64 = pack([1, 2, 0])
-            | pack([2, 1, 0]) << 6
-            | pack([2, 0, 1]) << 12
-            | pack([0, 2, 1]) << 18
-            | pack([0, 1, 2]) << 24
-            | pack([1, 0, 2]) << 30;
-        const fn pack(axes: [u64; 3]) -> u64 {
-            axes[0] | axes[1] << 2 | axes[2] << 4
-        }
-        let bits = AXES >> (6 * (2 * kz + down));
-        [(bits & 3) as usize, (bits >> 2 & 3) as usize, (bits >> 4 & 3) as usize]
+        2 * kz + down
     }
 
     /// The axes `[kx, ky, kz]`: the ray runs along `kz` in the sheared frame.

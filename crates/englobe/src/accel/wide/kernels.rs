@@ -17,6 +17,11 @@ use super::node::{NodeRay, WIDTH, WideNode};
 
 /// A slab test of all children of a node.
 pub trait NodeKernel: Copy {
+    /// Whether the processor that runs this kernel has AVX (the x86 kernels): code compiled with
+    /// the kernel's target features may then use it, as the triangle test's set-up does
+    /// ([`super::triangles::TriRay::new_avx`]).
+    const AVX: bool;
+
     /// Tests the ray against the eight children's boxes within `t_min..=limit`: bit `i` of the
     /// result is set if child `i` is entered, and `dist[i]` is then its entry distance.
     ///
@@ -39,6 +44,8 @@ pub trait NodeKernel: Copy {
 pub struct Portable;
 
 impl NodeKernel for Portable {
+    const AVX: bool = false;
+
     #[inline(always)]
     unsafe fn children(self, node: &WideNode, ray: &NodeRay, limit: f32, dist: &mut [f32; WIDTH]) -> u32 {
         portable_slabs::<false>(node, ray, limit, dist)
@@ -112,6 +119,8 @@ mod x86 {
     }
 
     impl NodeKernel for Avx2 {
+        const AVX: bool = true;
+
         #[inline(always)]
         unsafe fn children(self, node: &WideNode, ray: &NodeRay, limit: f32, dist: &mut [f32; WIDTH]) -> u32 {
             // SAFETY: AVX2 is guaranteed by the caller; `dist` holds eight floats.
@@ -138,6 +147,8 @@ mod x86 {
     pub struct Avx512;
 
     impl NodeKernel for Avx512 {
+        const AVX: bool = true;
+
         #[inline(always)]
         unsafe fn children(self, node: &WideNode, ray: &NodeRay, limit: f32, dist: &mut [f32; WIDTH]) -> u32 {
             // SAFETY: AVX-512 F and VL are guaranteed by the caller; `dist` holds eight floats.

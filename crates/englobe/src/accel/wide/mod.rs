@@ -186,7 +186,7 @@ impl<C: Counters, F: FnMut(u32, &Ray) -> Option<PrimHit>> Leaves<C> for ClosureL
     type Prepared = ();
 
     #[inline(always)]
-    fn prepare(&self) {}
+    fn prepare<K: kernels::NodeKernel>(&self) {}
 
     #[inline(always)]
     fn closest(&mut self, _: &(), first: u32, count: u32, counters: &mut C) {

@@ -57,8 +57,9 @@ pub trait Leaves<C: Counters> {
     /// in its own frame rather than in the leaves, which the compiler would otherwise copy in and
     /// out at every query, prepared or not.
     type Prepared;
-    /// Prepares the leaf tests of this query.
-    fn prepare(&self) -> Self::Prepared;
+    /// Prepares the leaf tests of this query, in a walk compiled for node kernel `K` (whose
+    /// instruction set the preparation may use).
+    fn prepare<K: NodeKernel>(&self) -> Self::Prepared;
     /// Tests the `count` items from `first` for the closest hit, shrinking the interval.
     fn closest(&mut self, prepared: &Self::Prepared, first: u32, count: u32, counters: &mut C);
     /// The end of the interval: the closest hit so far, or the ray's `t_max`.
@@ -165,9 +166,12 @@ fn give_back(deep: Vec<MaybeUninit<Entry>>) {
 ///
 /// Not `Option::get_or_insert_with`, for the reason given at [`stack_for`].
 #[inline(always)]
-fn prepare_once<'p, C: Counters, L: Leaves<C>>(slot: &'p mut Option<L::Prepared>, leaves: &L) -> &'p L::Prepared {
+fn prepare_once<'p, K: NodeKernel, C: Counters, L: Leaves<C>>(
+    slot: &'p mut Option<L::Prepared>,
+    leaves: &L,
+) -> &'p L::Prepared {
     if slot.is_none() {
-        *slot = Some(leaves.prepare());
+        *slot = Some(leaves.prepare::<K>());
     }
     // SAFETY: set just above if it was not.
     unsafe { slot.as_ref().unwrap_unchecked() }
@@ -218,7 +222,7 @@ pub unsafe fn closest<K: NodeKernel, C: Counters, L: Leaves<C>>(
     'walk: loop {
         {
             if is_leaf(current.reference) {
-                let prepared = prepare_once(&mut prepared_slot, leaves);
+                let prepared = prepare_once::<K, C, L>(&mut prepared_slot, leaves);
                 leaves.closest(prepared, index_of(current.reference), current.count, counters);
                 limit = reach(leaves.t_max());
             } else {
@@ -359,7 +363,7 @@ pub unsafe fn any<K: NodeKernel, C: Counters, L: Leaves<C>>(
     let hit = 'walk: loop {
         {
             if is_leaf(current.reference) {
-                let prepared = prepare_once(&mut prepared_slot, leaves);
+                let prepared = prepare_once::<K, C, L>(&mut prepared_slot, leaves);
                 if leaves.any(prepared, index_of(current.reference), current.count, counters) {
                     break 'walk true;
                 }

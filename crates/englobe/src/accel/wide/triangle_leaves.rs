@@ -25,6 +25,7 @@
 use std::cell::Cell;
 use std::mem::MaybeUninit;
 
+use super::kernels::NodeKernel;
 use super::traverse::Leaves;
 use super::triangles::{BlockHits, TriBlock, TriRay, UNUSED, intersect_block};
 use crate::accel::{Counters, Hit, HitFilter};
@@ -306,7 +307,12 @@ impl<C: Counters, F: HitFilter<Hit>> Leaves<C> for TriangleLeaves<'_, F> {
     type Prepared = TriRay;
 
     #[inline(always)]
-    fn prepare(&self) -> TriRay {
+    fn prepare<K: NodeKernel>(&self) -> TriRay {
+        #[cfg(target_arch = "x86_64")]
+        if K::AVX {
+            // SAFETY: a kernel that says so runs only where AVX is (`NodeKernel::AVX`).
+            return unsafe { TriRay::new_avx(self.source) };
+        }
         TriRay::new(self.source)
     }
 
@@ -390,6 +396,7 @@ mod tests {
     use glam::Vec3;
 
     use super::*;
+    use crate::accel::wide::kernels::Portable;
     use crate::accel::{NoCount, NoFilter};
     use crate::shapes::{WatertightRay, intersect_triangle};
 
@@ -429,7 +436,7 @@ mod tests {
             let mut walks = 0;
             let best = closest_hit(&blocks, &ray, ray.t_max, NoFilter, |leaves| {
                 walks += 1;
-                let prepared = Leaves::<NoCount>::prepare(leaves);
+                let prepared = Leaves::<NoCount>::prepare::<Portable>(leaves);
                 Leaves::<NoCount>::closest(leaves, &prepared, 0, blocks.len() as u32, &mut NoCount);
                 Leaves::<NoCount>::settle_closest(leaves);
             });
@@ -441,7 +448,7 @@ mod tests {
                 let mut walks = 0;
                 let hit = any_hit(&blocks, &short, t_max, NoFilter, |leaves| {
                     walks += 1;
-                    let prepared = Leaves::<NoCount>::prepare(leaves);
+                    let prepared = Leaves::<NoCount>::prepare::<Portable>(leaves);
                     Leaves::<NoCount>::any(leaves, &prepared, 0, blocks.len() as u32, &mut NoCount)
                         || Leaves::<NoCount>::settle_any(leaves)
                 });

@@ -21,6 +21,7 @@
 //! every hit, so of any the packet found for it.
 
 use super::dispatch;
+use super::kernels::Portable;
 use super::node::{NodeRay, reach};
 use super::packet::PacketLeaves;
 use super::packet_kernels::{Lanes, PACKET, PacketRays};
@@ -318,14 +319,15 @@ impl LeafTest for RayByRay {
         mut rays: u32,
         counters: &mut C,
     ) {
-        // The rays' triangle constants are prepared at each leaf: only processors without
+        // The rays' triangle constants are prepared at each leaf, in the portable form (a
+        // closure is compiled without the walk's target features): only processors without
         // AVX-512 come here.
         while rays != 0 {
             let i = take_lowest(&mut rays);
             let source = leaves.packet.ray(i);
             let t_max = leaves.best.t.0[i];
             let best = triangle_leaves::closest_hit(leaves.bvh.blocks(), &source, t_max, NoFilter, |lane| {
-                let ray = Leaves::<C>::prepare(lane);
+                let ray = Leaves::<C>::prepare::<Portable>(lane);
                 Leaves::<C>::closest(lane, &ray, first, count, counters);
                 Leaves::<C>::settle_closest(lane);
             });
@@ -349,7 +351,7 @@ impl LeafTest for RayByRay {
             let i = take_lowest(&mut rays);
             let source = leaves.packet.ray(i);
             if triangle_leaves::any_hit(leaves.bvh.blocks(), &source, leaves.best.t.0[i], NoFilter, |lane| {
-                let ray = Leaves::<C>::prepare(lane);
+                let ray = Leaves::<C>::prepare::<Portable>(lane);
                 Leaves::<C>::any(lane, &ray, first, count, counters) || Leaves::<C>::settle_any(lane)
             }) {
                 found |= 1 << i;
