@@ -88,7 +88,7 @@ impl WatertightRay {
     /// the shear.
     #[inline(always)]
     pub fn axes_of(d: Vec3) -> [usize; 3] {
-        let bits = AXES >> (6 * Self::axes_code(d));
+        let bits = Self::AXES >> (6 * Self::axes_code(d));
         [(bits & 3) as usize, (bits >> 2 & 3) as usize, (bits >> 4 & 3) as usize]
     }
 
