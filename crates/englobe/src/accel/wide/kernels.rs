@@ -17,10 +17,10 @@ use super::node::{NodeRay, WIDTH, WideNode};
 
 /// A slab test of all children of a node.
 pub trait NodeKernel: Copy {
-    /// Whether the processor that runs this kernel has AVX (the x86 kernels): code compiled with
-    /// the kernel's target features may then use it, as the triangle test's set-up does
-    /// ([`super::triangles::TriRay::new_avx`]).
-    const AVX: bool;
+    /// Whether the processor that runs this kernel has AVX (the x86 kernels say so): code
+    /// compiled with the kernel's target features may then use it, as the triangle test's set-up
+    /// does ([`super::triangles::TriRay::new_avx`]). False unless a kernel says so.
+    const AVX: bool = false;
 
     /// Tests the ray against the eight children's boxes within `t_min..=limit`: bit `i` of the
     /// result is set if child `i` is entered, and `dist[i]` is then its entry distance.
@@ -44,8 +44,6 @@ pub trait NodeKernel: Copy {
 pub struct Portable;
 
 impl NodeKernel for Portable {
-    const AVX: bool = false;
-
     #[inline(always)]
     unsafe fn children(self, node: &WideNode, ray: &NodeRay, limit: f32, dist: &mut [f32; WIDTH]) -> u32 {
         portable_slabs::<false>(node, ray, limit, dist)
