@@ -22,6 +22,12 @@ Where `docs/performance.md` takes its per-instruction figures from, for example:
     scripts/annotate-instructions.py any.out x86::ray_query_avx2 400000
 
 (with the harness built for `-C target-cpu=x86-64-v3`: valgrind cannot run AVX-512).
+
+RAYS must count every query the profiled run made to the function. Before measuring, the harness
+traces its primary rays once with englobe's closest-hit query, to start the bounce rays from their
+hits: a closest-hit profile counts those `resolution * resolution` queries too (16 384 more at
+`--resolution 128`, 4 % of 400 000). Profile closest-hit cells with a small `--resolution` (8),
+or add them to RAYS.
 """
 
 import collections
