@@ -95,7 +95,7 @@ impl WatertightRay {
     /// Which of the six orders [`WatertightRay::axes_of`] gives for a ray of direction `d`:
     /// `2 * kz + down`, `down` being 1 if the ray goes down `kz`.
     #[inline(always)]
-    pub fn axes_code(d: Vec3) -> u32 {
+    pub(crate) fn axes_code(d: Vec3) -> u32 {
         // `kz` is the axis of the largest component (the first of equal ones); `kx, ky` follow it
         // cyclically, swapped if the ray goes down `kz` so that the triangles' winding is kept.
         // Computed without branches: the axis of a random ray is a coin toss that a branch

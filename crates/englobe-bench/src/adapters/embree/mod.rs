@@ -5,6 +5,10 @@
 //! scene flag (`RTC_SCENE_FLAG_ROBUST` only on request). Single rays use `rtcIntersect1` and
 //! `rtcOccluded1` with an incoherent context (the default); packets use `rtcIntersect16` and
 //! `rtcOccluded16` with a coherent context, as Embree's own tutorials do for camera rays.
+//!
+//! `ENGLOBE_EMBREE_CONFIG`, if set, is added to the device's configuration string, for Embree's
+//! own diagnostics: `verbose=3` prints each build's tree (nodes, leaves, SAH cost), as
+//! docs/performance.md quotes it.
 
 pub mod ffi;
 
@@ -45,11 +49,13 @@ pub fn device(threads: usize) -> anyhow::Result<Arc<Device>> {
         return Ok(d.clone());
     }
     *current = None;
-    let config = CString::new(format!("threads={threads}")).expect("no NUL in the configuration");
+    let extra = std::env::var("ENGLOBE_EMBREE_CONFIG").map(|c| format!(",{c}")).unwrap_or_default();
+    let text = format!("threads={threads}{extra}");
+    let config = CString::new(text.clone()).context("ENGLOBE_EMBREE_CONFIG holds a NUL byte")?;
     // SAFETY: a valid NUL-terminated configuration string; a null device is checked below.
     let raw = unsafe { rtcNewDevice(config.as_ptr()) };
     if raw.is_null() {
-        bail!("Embree refused to create a device (rtcNewDevice returned null)");
+        bail!("Embree refused to create a device with the configuration `{text}` (rtcNewDevice returned null)");
     }
     let d = Arc::new(Device(raw));
     *current = Some((threads, d.clone()));
