@@ -1,6 +1,8 @@
 //! The one place where a query picks its compiled kernels: a `match` on the structure's
 //! instruction set, each arm a copy of the traversal compiled with that set's target features
-//! (`#[target_feature]`, so one binary carries them all and runs on any x86-64).
+//! (`#[target_feature]`, so one binary carries them all and runs on any x86-64). Within an x86
+//! copy, a single-ray walk takes the fused node test where it applies to the ray (see
+//! [`super::fused`]) and the exact-order one elsewhere: two walks in each copy.
 //!
 //! Soundness: the AVX2 and AVX-512 copies may only run on processors that have those features.
 //! A structure's [`Isa`] is chosen by [`Isa::best`] or changed only through a setter that checks
@@ -12,6 +14,7 @@ use super::node::{NodeRay, WideNode};
 use super::packet::{self, PacketLeaves};
 use super::packet_kernels::{PacketRays, ScalarPacket};
 use super::traverse::{self, Leaves};
+use crate::Ray;
 use crate::accel::Counters;
 
 /// The closest-hit traversal compiled for `isa`, which the processor must have (see the module
@@ -185,19 +188,23 @@ pub fn packet_query<Q: PacketQuery>(isa: Isa, query: Q) -> Q::Output {
 }
 
 /// A single-ray query from a ray that may enter the tree to the answer: compiled by [`ray_query`]
-/// with the structure's instruction set and walked with that set's node kernel, so that its
-/// set-up (the node test's constants, the leaves' state) is made in the same function as the walk
-/// instead of being handed over to it in memory.
+/// with the structure's instruction set and walked with that set's node kernel (the fused one
+/// where it applies, see [`super::fused`]), so that its set-up (the node test's constants, the
+/// leaves' state) is made in the same function as the walk instead of being handed over to it in
+/// memory.
 pub trait RayQuery {
     /// What the query returns.
     type Output;
-    /// Runs the query with `kernel`. Implementations are `#[inline(always)]`, so that their body
-    /// is compiled into the copy that calls them.
+    /// The query's ray.
+    fn ray(&self) -> &Ray;
+    /// Runs the query with `kernel`, `ray` being [`RayQuery::ray`] prepared for it.
+    /// Implementations are `#[inline(always)]`, so that their body is compiled into the copy that
+    /// calls them.
     ///
     /// # Safety
     /// As [`NodeKernel::children`]: compiled with the kernel's target features, run on a processor
     /// that has them.
-    unsafe fn run<K: NodeKernel>(self, kernel: K) -> Self::Output;
+    unsafe fn run<K: NodeKernel>(self, kernel: K, ray: NodeRay) -> Self::Output;
 }
 
 /// Runs `query` compiled for `isa`, which the processor must have (see the module documentation).
@@ -225,8 +232,9 @@ mod portable {
 
     #[inline(never)]
     pub fn ray_query<Q: RayQuery>(query: Q) -> Q::Output {
+        let ray = NodeRay::new(query.ray());
         // SAFETY: the portable kernel needs nothing beyond the target's baseline.
-        unsafe { query.run(Portable) }
+        unsafe { query.run(Portable, ray) }
     }
 
     #[inline(never)]
@@ -283,7 +291,7 @@ mod portable {
 
 #[cfg(target_arch = "x86_64")]
 mod x86 {
-    use super::super::kernels::{Avx2, Avx512};
+    use super::super::kernels::{Avx2, Avx2Fused, Avx512, Avx512Fused};
     use super::super::packet_kernels::{Avx2Packet, Avx512Packet};
     use super::*;
 
@@ -305,16 +313,18 @@ mod x86 {
     /// The processor has AVX2, FMA and the bit instructions that come with them (see `Isa`).
     #[target_feature(enable = "avx2,fma,bmi1,bmi2,lzcnt,popcnt")]
     pub unsafe fn ray_query_avx2<Q: RayQuery>(query: Q) -> Q::Output {
+        let ray = NodeRay::new(query.ray());
         // SAFETY: compiled with AVX2, which the caller guarantees.
-        unsafe { query.run(Avx2) }
+        unsafe { if ray.fused.applies { query.run(Avx2Fused, ray) } else { query.run(Avx2, ray) } }
     }
 
     /// # Safety
     /// The processor has AVX-512 F, VL, BW and DQ (and AVX2).
     #[target_feature(enable = "avx2,fma,bmi1,bmi2,lzcnt,popcnt,avx512f,avx512vl,avx512bw,avx512dq")]
     pub unsafe fn ray_query_avx512<Q: RayQuery>(query: Q) -> Q::Output {
+        let ray = NodeRay::new(query.ray());
         // SAFETY: compiled with AVX-512, which the caller guarantees.
-        unsafe { query.run(Avx512) }
+        unsafe { if ray.fused.applies { query.run(Avx512Fused, ray) } else { query.run(Avx512, ray) } }
     }
 
     /// # Safety
@@ -329,7 +339,13 @@ mod x86 {
         counters: &mut C,
     ) {
         // SAFETY: compiled with AVX2, which the caller guarantees.
-        unsafe { traverse::closest(Avx2, nodes, depth, start, ray, leaves, counters) }
+        unsafe {
+            if ray.fused.applies {
+                traverse::closest(Avx2Fused, nodes, depth, start, ray, leaves, counters)
+            } else {
+                traverse::closest(Avx2, nodes, depth, start, ray, leaves, counters)
+            }
+        }
     }
 
     /// # Safety
@@ -344,7 +360,13 @@ mod x86 {
         counters: &mut C,
     ) {
         // SAFETY: compiled with AVX-512, which the caller guarantees.
-        unsafe { traverse::closest(Avx512, nodes, depth, start, ray, leaves, counters) }
+        unsafe {
+            if ray.fused.applies {
+                traverse::closest(Avx512Fused, nodes, depth, start, ray, leaves, counters)
+            } else {
+                traverse::closest(Avx512, nodes, depth, start, ray, leaves, counters)
+            }
+        }
     }
 
     /// # Safety
@@ -360,7 +382,13 @@ mod x86 {
         counters: &mut C,
     ) -> bool {
         // SAFETY: compiled with AVX2, which the caller guarantees.
-        unsafe { traverse::any(Avx2, nodes, depth, start, ray, limit, leaves, counters) }
+        unsafe {
+            if ray.fused.applies {
+                traverse::any(Avx2Fused, nodes, depth, start, ray, limit, leaves, counters)
+            } else {
+                traverse::any(Avx2, nodes, depth, start, ray, limit, leaves, counters)
+            }
+        }
     }
 
     /// # Safety
@@ -376,7 +404,13 @@ mod x86 {
         counters: &mut C,
     ) -> bool {
         // SAFETY: compiled with AVX-512, which the caller guarantees.
-        unsafe { traverse::any(Avx512, nodes, depth, start, ray, limit, leaves, counters) }
+        unsafe {
+            if ray.fused.applies {
+                traverse::any(Avx512Fused, nodes, depth, start, ray, limit, leaves, counters)
+            } else {
+                traverse::any(Avx512, nodes, depth, start, ray, limit, leaves, counters)
+            }
+        }
     }
 
     /// # Safety

@@ -79,7 +79,7 @@ fn portable_slabs<const EXITS: bool>(node: &WideNode, ray: &NodeRay, limit: f32,
 }
 
 #[cfg(target_arch = "x86_64")]
-pub use x86::{Avx2, Avx512};
+pub use x86::{Avx2, Avx2Fused, Avx512, Avx512Fused};
 
 #[cfg(target_arch = "x86_64")]
 mod x86 {
@@ -167,6 +167,90 @@ mod x86 {
             }
         }
     }
+
+    /// Entry and exit distances of the eight children in the fused form ([`super::super::fused`]),
+    /// for a ray to which it applies: a multiply-add per plane, the four entries and the four
+    /// exits each reduced in two steps.
+    #[inline(always)]
+    unsafe fn slabs_fused(node: &WideNode, ray: &NodeRay, limit: f32) -> (__m256, __m256) {
+        // SAFETY (for the whole function): the caller guarantees AVX2 and FMA; the loads as in
+        // `slabs`.
+        unsafe {
+            let p = &ray.fused;
+            // A loop rather than closures: a closure is compiled without the caller's target
+            // features, and its intrinsics would become calls.
+            let (mut near, mut far) = ([_mm256_setzero_ps(); 3], [_mm256_setzero_ps(); 3]);
+            for a in 0..3 {
+                let (lo, hi) = (ray.row(node, a, 0).as_ptr(), ray.row(node, a, 1).as_ptr());
+                near[a] =
+                    _mm256_fmadd_ps(_mm256_load_ps(lo), _mm256_set1_ps(ray.inv_dir[a]), _mm256_set1_ps(p.near[a]));
+                far[a] = _mm256_fmadd_ps(_mm256_load_ps(hi), _mm256_set1_ps(p.inv_far[a]), _mm256_set1_ps(p.far[a]));
+            }
+            let enter =
+                _mm256_max_ps(_mm256_max_ps(near[0], near[1]), _mm256_max_ps(near[2], _mm256_set1_ps(ray.t_min)));
+            let exit = _mm256_min_ps(_mm256_min_ps(far[0], far[1]), _mm256_min_ps(far[2], _mm256_set1_ps(limit)));
+            (enter, exit)
+        }
+    }
+
+    /// The fused node test ([`super::super::fused`]) with AVX2 and FMA, for the rays to which it
+    /// applies; the dispatch gives the others [`Avx2`].
+    #[derive(Clone, Copy, Debug)]
+    pub struct Avx2Fused;
+
+    impl NodeKernel for Avx2Fused {
+        const AVX: bool = true;
+
+        #[inline(always)]
+        unsafe fn children(self, node: &WideNode, ray: &NodeRay, limit: f32, dist: &mut [f32; WIDTH]) -> u32 {
+            // SAFETY: AVX2 and FMA are guaranteed by the caller; `dist` holds eight floats.
+            unsafe {
+                let (enter, exit) = slabs_fused(node, ray, limit);
+                _mm256_storeu_ps(dist.as_mut_ptr(), enter);
+                _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(enter, exit)) as u32
+            }
+        }
+
+        #[inline(always)]
+        unsafe fn children_exits(self, node: &WideNode, ray: &NodeRay, limit: f32, dist: &mut [f32; WIDTH]) -> u32 {
+            // SAFETY: as in `children`.
+            unsafe {
+                let (enter, exit) = slabs_fused(node, ray, limit);
+                _mm256_storeu_ps(dist.as_mut_ptr(), exit);
+                _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(enter, exit)) as u32
+            }
+        }
+    }
+
+    /// The fused node test with AVX-512 (VL), for the rays to which it applies; the dispatch
+    /// gives the others [`Avx512`].
+    #[derive(Clone, Copy, Debug)]
+    pub struct Avx512Fused;
+
+    impl NodeKernel for Avx512Fused {
+        const AVX: bool = true;
+
+        #[inline(always)]
+        unsafe fn children(self, node: &WideNode, ray: &NodeRay, limit: f32, dist: &mut [f32; WIDTH]) -> u32 {
+            // SAFETY: AVX-512 F and VL (and FMA) are guaranteed by the caller; `dist` holds eight
+            // floats.
+            unsafe {
+                let (enter, exit) = slabs_fused(node, ray, limit);
+                _mm256_storeu_ps(dist.as_mut_ptr(), enter);
+                _mm256_cmp_ps_mask::<_CMP_LE_OQ>(enter, exit) as u32
+            }
+        }
+
+        #[inline(always)]
+        unsafe fn children_exits(self, node: &WideNode, ray: &NodeRay, limit: f32, dist: &mut [f32; WIDTH]) -> u32 {
+            // SAFETY: as in `children`.
+            unsafe {
+                let (enter, exit) = slabs_fused(node, ray, limit);
+                _mm256_storeu_ps(dist.as_mut_ptr(), exit);
+                _mm256_cmp_ps_mask::<_CMP_LE_OQ>(enter, exit) as u32
+            }
+        }
+    }
 }
 
 #[cfg(test)]
@@ -176,6 +260,7 @@ mod tests {
     use rand_pcg::Pcg32;
 
     use super::*;
+    use crate::accel::wide::fused::{child_distances_fused_scalar, child_entry_fused_scalar};
     use crate::accel::wide::isa::Isa;
     use crate::accel::wide::node::{child_entry_scalar, reach};
     use crate::{Aabb, Ray};
@@ -226,7 +311,48 @@ mod tests {
             }
             assert_eq!(exits[slot].to_bits(), exit.to_bits(), "{isa}: slot {slot} of {node:?}, {ray:?}");
         }
+        if r.fused.applies {
+            check_fused(isa, node, ray, &r, limit);
+        }
         mask.count_ones()
+    }
+
+    /// The fused kernel of `isa` (none for the portable one) against the fused scalar test, bit
+    /// for bit, entries and exits.
+    fn check_fused(isa: Isa, node: &WideNode, ray: &Ray, r: &NodeRay, limit: f32) {
+        let (mut entries, mut exits) = ([0.0; WIDTH], [0.0; WIDTH]);
+        // SAFETY: as in `check`.
+        let (mask, exit_mask) = unsafe {
+            match isa {
+                Isa::Portable => return,
+                #[cfg(target_arch = "x86_64")]
+                Isa::Avx2 => (
+                    Avx2Fused.children(node, r, limit, &mut entries),
+                    Avx2Fused.children_exits(node, r, limit, &mut exits),
+                ),
+                #[cfg(target_arch = "x86_64")]
+                Isa::Avx512 => (
+                    Avx512Fused.children(node, r, limit, &mut entries),
+                    Avx512Fused.children_exits(node, r, limit, &mut exits),
+                ),
+                #[cfg(not(target_arch = "x86_64"))]
+                _ => unreachable!(),
+            }
+        };
+        assert_eq!(exit_mask, mask, "{isa}, fused: {node:?}, {ray:?}");
+        for slot in 0..WIDTH {
+            let expected = child_entry_fused_scalar(node, slot, r, limit);
+            let got = (mask >> slot & 1 != 0).then_some(entries[slot]);
+            assert_eq!(
+                expected.map(f32::to_bits),
+                got.map(f32::to_bits),
+                "{isa}, fused: slot {slot} of {node:?}, {ray:?}"
+            );
+            if got.is_some() {
+                let exit = child_distances_fused_scalar(node, slot, r, limit).1;
+                assert_eq!(exits[slot].to_bits(), exit.to_bits(), "{isa}, fused: slot {slot} of {node:?}, {ray:?}");
+            }
+        }
     }
 
     #[test]

@@ -45,6 +45,7 @@ pub mod convert;
 // The per-query choice of compiled kernels: safe to call only with a structure's own nodes and
 // instruction set, so it stays inside the crate.
 pub(crate) mod dispatch;
+pub mod fused;
 pub mod isa;
 pub mod kernels;
 pub mod node;

@@ -12,6 +12,7 @@
 //! with the number of items in [`WideNode::counts`]. Unused slots have [`EMPTY`] and an empty box
 //! (`+inf` below, `-inf` above) that no ray enters: the slab test rejects it without a special case.
 
+use super::fused::FusedPlanes;
 use crate::geom::aabb::ROBUST_FAR_SCALE;
 use crate::{Aabb, Ray};
 
@@ -112,6 +113,9 @@ pub struct NodeRay {
     pub inv_far: [f32; 3],
     /// The ray's `t_min`.
     pub t_min: f32,
+    /// The constants of the fused node test, and whether it applies to the ray
+    /// ([`super::fused`]).
+    pub fused: FusedPlanes,
     /// Byte offset of the near row of each axis in [`WideNode::bounds`], for kernels that load
     /// rows without an index check; the far row is the axis's other one, at `near ^ ROW_BYTES`
     /// (rows `2a` and `2a + 1` differ in that bit alone), so that a query makes three offsets
@@ -138,6 +142,7 @@ impl NodeRay {
             inv_dir: inv.to_array(),
             inv_far: (inv * ROBUST_FAR_SCALE).to_array(),
             t_min: ray.t_min,
+            fused: FusedPlanes::new(ray),
             row_bytes: [near(0), near(1), near(2)],
         }
     }

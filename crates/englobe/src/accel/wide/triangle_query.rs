@@ -56,11 +56,16 @@ impl<C: Counters, F: HitFilter<Hit>> RayQuery for Any<'_, C, F> {
     type Output = bool;
 
     #[inline(always)]
-    unsafe fn run<K: NodeKernel>(self, kernel: K) -> bool {
+    fn ray(&self) -> &Ray {
+        self.ray
+    }
+
+    #[inline(always)]
+    unsafe fn run<K: NodeKernel>(self, kernel: K, node_ray: NodeRay) -> bool {
         let Any { bvh, ray, counters, filter } = self;
         debug_assert!(ray.is_valid() && !bvh.nodes().is_empty());
         // SAFETY: `run`'s guarantee.
-        let mut walk = unsafe { TreeWalk::new(kernel, bvh, ray, counters) };
+        let mut walk = unsafe { TreeWalk::new(kernel, bvh, ray, node_ray, counters) };
         triangle_leaves::any_hit_with(bvh.blocks(), ray, ray.t_max, filter, &mut walk)
     }
 }
@@ -78,19 +83,19 @@ struct TreeWalk<'a, K, C> {
 }
 
 impl<'a, K: NodeKernel, C: Counters> TreeWalk<'a, K, C> {
-    /// The walks of `ray` in `bvh`.
+    /// The walks of `ray` (prepared as `node_ray`) in `bvh`.
     ///
     /// # Safety
     /// As [`NodeKernel::children`]: the walks run compiled with the kernel's target features, on
     /// a processor that has them.
     #[inline(always)]
-    unsafe fn new(kernel: K, bvh: &'a TriangleBvh, ray: &Ray, counters: &'a mut C) -> Self {
+    unsafe fn new(kernel: K, bvh: &'a TriangleBvh, ray: &Ray, node_ray: NodeRay, counters: &'a mut C) -> Self {
         TreeWalk {
             kernel,
             isa: bvh.isa(),
             nodes: bvh.nodes(),
             depth: bvh.depth(),
-            ray: NodeRay::new(ray),
+            ray: node_ray,
             limit: reach(ray.t_max),
             counters,
         }
