@@ -1,20 +1,22 @@
 //! The one place where a query picks its compiled kernels: a `match` on the structure's
 //! instruction set, each arm a copy of the traversal compiled with that set's target features
-//! (`#[target_feature]`, so one binary carries them all and runs on any x86-64). Within an x86
-//! copy, a single-ray walk takes the fused node test where it applies to the ray (see
-//! [`super::fused`]) and the exact-order one elsewhere: two walks in each copy.
+//! (`#[target_feature]`, so one binary carries them all and runs on any x86-64). With AVX-512, a
+//! single-ray query whose ray the fused node test applies to (see [`super::fused`]) takes a
+//! copy of the walk compiled with it, the others the exact-order test's copy: the choice is made
+//! before the call, so that each copy keeps its own registers.
 //!
 //! Soundness: the AVX2 and AVX-512 copies may only run on processors that have those features.
 //! A structure's [`Isa`] is chosen by [`Isa::best`] or changed only through a setter that checks
 //! [`Isa::is_available`], so an arm is only ever taken on a processor that can run it.
 
+#[cfg(target_arch = "x86_64")]
+use super::fused;
 use super::isa::Isa;
 use super::kernels::{NodeKernel, Portable};
 use super::node::{NodeRay, WideNode};
 use super::packet::{self, PacketLeaves};
 use super::packet_kernels::{PacketRays, ScalarPacket};
 use super::traverse::{self, Leaves};
-use crate::Ray;
 use crate::accel::Counters;
 
 /// The closest-hit traversal compiled for `isa`, which the processor must have (see the module
@@ -35,6 +37,11 @@ pub fn closest<C: Counters, L: Leaves<C>>(
         // SAFETY: the structure's instruction set is one the processor has (module documentation).
         #[cfg(target_arch = "x86_64")]
         Isa::Avx2 => unsafe { x86::closest_avx2(nodes, depth, start, ray, leaves, counters) },
+        // SAFETY: as above.
+        #[cfg(target_arch = "x86_64")]
+        Isa::Avx512 if fused::applies_to(ray) => unsafe {
+            x86::closest_avx512_fused(nodes, depth, start, ray, leaves, counters)
+        },
         // SAFETY: as above.
         #[cfg(target_arch = "x86_64")]
         Isa::Avx512 => unsafe { x86::closest_avx512(nodes, depth, start, ray, leaves, counters) },
@@ -62,6 +69,11 @@ pub fn any<C: Counters, L: Leaves<C>>(
         // SAFETY: the structure's instruction set is one the processor has (module documentation).
         #[cfg(target_arch = "x86_64")]
         Isa::Avx2 => unsafe { x86::any_avx2(nodes, depth, start, ray, limit, leaves, counters) },
+        // SAFETY: as above.
+        #[cfg(target_arch = "x86_64")]
+        Isa::Avx512 if fused::applies_to(ray) => unsafe {
+            x86::any_avx512_fused(nodes, depth, start, ray, limit, leaves, counters)
+        },
         // SAFETY: as above.
         #[cfg(target_arch = "x86_64")]
         Isa::Avx512 => unsafe { x86::any_avx512(nodes, depth, start, ray, limit, leaves, counters) },
@@ -188,23 +200,22 @@ pub fn packet_query<Q: PacketQuery>(isa: Isa, query: Q) -> Q::Output {
 }
 
 /// A single-ray query from a ray that may enter the tree to the answer: compiled by [`ray_query`]
-/// with the structure's instruction set and walked with that set's node kernel (the fused one
-/// where it applies, see [`super::fused`]), so that its set-up (the node test's constants, the
+/// with the structure's instruction set and walked with that set's node kernel (with AVX-512, the
+/// fused one where it applies, see [`super::fused`]), so that its set-up (the node test's constants, the
 /// leaves' state) is made in the same function as the walk instead of being handed over to it in
 /// memory.
 pub trait RayQuery {
     /// What the query returns.
     type Output;
-    /// The query's ray.
-    fn ray(&self) -> &Ray;
-    /// Runs the query with `kernel`, `ray` being [`RayQuery::ray`] prepared for it.
-    /// Implementations are `#[inline(always)]`, so that their body is compiled into the copy that
-    /// calls them.
+    /// Whether the fused node test applies to the query's ray ([`super::fused::applies`]).
+    fn fused(&self) -> bool;
+    /// Runs the query with `kernel`. Implementations are `#[inline(always)]`, so that their body
+    /// is compiled into the copy that calls them.
     ///
     /// # Safety
     /// As [`NodeKernel::children`]: compiled with the kernel's target features, run on a processor
     /// that has them.
-    unsafe fn run<K: NodeKernel>(self, kernel: K, ray: NodeRay) -> Self::Output;
+    unsafe fn run<K: NodeKernel>(self, kernel: K) -> Self::Output;
 }
 
 /// Runs `query` compiled for `isa`, which the processor must have (see the module documentation).
@@ -216,6 +227,9 @@ pub fn ray_query<Q: RayQuery>(isa: Isa, query: Q) -> Q::Output {
         // SAFETY: the structure's instruction set is one the processor has (module documentation).
         #[cfg(target_arch = "x86_64")]
         Isa::Avx2 => unsafe { x86::ray_query_avx2(query) },
+        // SAFETY: as above.
+        #[cfg(target_arch = "x86_64")]
+        Isa::Avx512 if query.fused() => unsafe { x86::ray_query_avx512_fused(query) },
         // SAFETY: as above.
         #[cfg(target_arch = "x86_64")]
         Isa::Avx512 => unsafe { x86::ray_query_avx512(query) },
@@ -232,9 +246,8 @@ mod portable {
 
     #[inline(never)]
     pub fn ray_query<Q: RayQuery>(query: Q) -> Q::Output {
-        let ray = NodeRay::new(query.ray());
         // SAFETY: the portable kernel needs nothing beyond the target's baseline.
-        unsafe { query.run(Portable, ray) }
+        unsafe { query.run(Portable) }
     }
 
     #[inline(never)]
@@ -291,7 +304,8 @@ mod portable {
 
 #[cfg(target_arch = "x86_64")]
 mod x86 {
-    use super::super::kernels::{Avx2, Avx2Fused, Avx512, Avx512Fused};
+    use super::super::fused::FusedPlanes;
+    use super::super::kernels::{Avx2, Avx512, Avx512Fused};
     use super::super::packet_kernels::{Avx2Packet, Avx512Packet};
     use super::*;
 
@@ -313,18 +327,24 @@ mod x86 {
     /// The processor has AVX2, FMA and the bit instructions that come with them (see `Isa`).
     #[target_feature(enable = "avx2,fma,bmi1,bmi2,lzcnt,popcnt")]
     pub unsafe fn ray_query_avx2<Q: RayQuery>(query: Q) -> Q::Output {
-        let ray = NodeRay::new(query.ray());
         // SAFETY: compiled with AVX2, which the caller guarantees.
-        unsafe { if ray.fused.applies { query.run(Avx2Fused, ray) } else { query.run(Avx2, ray) } }
+        unsafe { query.run(Avx2) }
     }
 
     /// # Safety
     /// The processor has AVX-512 F, VL, BW and DQ (and AVX2).
     #[target_feature(enable = "avx2,fma,bmi1,bmi2,lzcnt,popcnt,avx512f,avx512vl,avx512bw,avx512dq")]
     pub unsafe fn ray_query_avx512<Q: RayQuery>(query: Q) -> Q::Output {
-        let ray = NodeRay::new(query.ray());
         // SAFETY: compiled with AVX-512, which the caller guarantees.
-        unsafe { if ray.fused.applies { query.run(Avx512Fused, ray) } else { query.run(Avx512, ray) } }
+        unsafe { query.run(Avx512) }
+    }
+
+    /// # Safety
+    /// As [`ray_query_avx512`]; and the fused node test applies to the query's ray.
+    #[target_feature(enable = "avx2,fma,bmi1,bmi2,lzcnt,popcnt,avx512f,avx512vl,avx512bw,avx512dq")]
+    pub unsafe fn ray_query_avx512_fused<Q: RayQuery>(query: Q) -> Q::Output {
+        // SAFETY: compiled with AVX-512, which the caller guarantees.
+        unsafe { query.run(Avx512Fused(FusedPlanes::NONE)) }
     }
 
     /// # Safety
@@ -339,13 +359,7 @@ mod x86 {
         counters: &mut C,
     ) {
         // SAFETY: compiled with AVX2, which the caller guarantees.
-        unsafe {
-            if ray.fused.applies {
-                traverse::closest(Avx2Fused, nodes, depth, start, ray, leaves, counters)
-            } else {
-                traverse::closest(Avx2, nodes, depth, start, ray, leaves, counters)
-            }
-        }
+        unsafe { traverse::closest(Avx2, nodes, depth, start, ray, leaves, counters) }
     }
 
     /// # Safety
@@ -360,13 +374,22 @@ mod x86 {
         counters: &mut C,
     ) {
         // SAFETY: compiled with AVX-512, which the caller guarantees.
-        unsafe {
-            if ray.fused.applies {
-                traverse::closest(Avx512Fused, nodes, depth, start, ray, leaves, counters)
-            } else {
-                traverse::closest(Avx512, nodes, depth, start, ray, leaves, counters)
-            }
-        }
+        unsafe { traverse::closest(Avx512, nodes, depth, start, ray, leaves, counters) }
+    }
+
+    /// # Safety
+    /// As [`closest_avx512`]; and the fused node test applies to `ray`.
+    #[target_feature(enable = "avx2,fma,bmi1,bmi2,lzcnt,popcnt,avx512f,avx512vl,avx512bw,avx512dq")]
+    pub unsafe fn closest_avx512_fused<C: Counters, L: Leaves<C>>(
+        nodes: &[WideNode],
+        depth: u32,
+        start: u32,
+        ray: &NodeRay,
+        leaves: &mut L,
+        counters: &mut C,
+    ) {
+        // SAFETY: compiled with AVX-512, which the caller guarantees.
+        unsafe { traverse::closest(Avx512Fused(FusedPlanes::NONE), nodes, depth, start, ray, leaves, counters) }
     }
 
     /// # Safety
@@ -382,13 +405,7 @@ mod x86 {
         counters: &mut C,
     ) -> bool {
         // SAFETY: compiled with AVX2, which the caller guarantees.
-        unsafe {
-            if ray.fused.applies {
-                traverse::any(Avx2Fused, nodes, depth, start, ray, limit, leaves, counters)
-            } else {
-                traverse::any(Avx2, nodes, depth, start, ray, limit, leaves, counters)
-            }
-        }
+        unsafe { traverse::any(Avx2, nodes, depth, start, ray, limit, leaves, counters) }
     }
 
     /// # Safety
@@ -404,13 +421,24 @@ mod x86 {
         counters: &mut C,
     ) -> bool {
         // SAFETY: compiled with AVX-512, which the caller guarantees.
-        unsafe {
-            if ray.fused.applies {
-                traverse::any(Avx512Fused, nodes, depth, start, ray, limit, leaves, counters)
-            } else {
-                traverse::any(Avx512, nodes, depth, start, ray, limit, leaves, counters)
-            }
-        }
+        unsafe { traverse::any(Avx512, nodes, depth, start, ray, limit, leaves, counters) }
+    }
+
+    /// # Safety
+    /// As [`any_avx512`]; and the fused node test applies to `ray`.
+    #[target_feature(enable = "avx2,fma,bmi1,bmi2,lzcnt,popcnt,avx512f,avx512vl,avx512bw,avx512dq")]
+    #[allow(clippy::too_many_arguments)]
+    pub unsafe fn any_avx512_fused<C: Counters, L: Leaves<C>>(
+        nodes: &[WideNode],
+        depth: u32,
+        start: u32,
+        ray: &NodeRay,
+        limit: f32,
+        leaves: &mut L,
+        counters: &mut C,
+    ) -> bool {
+        // SAFETY: compiled with AVX-512, which the caller guarantees.
+        unsafe { traverse::any(Avx512Fused(FusedPlanes::NONE), nodes, depth, start, ray, limit, leaves, counters) }
     }
 
     /// # Safety

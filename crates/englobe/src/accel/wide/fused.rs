@@ -1,87 +1,152 @@
 //! The node test in Embree's form (Wald et al. 2014): one fused multiply-add per plane,
 //! `plane * inv + c` with `c = -origin * inv` made once per ray, and the entry and exit as the
-//! largest and smallest of four values in two steps rather than three, for the x86 kernels'
+//! largest and smallest of four values in two steps rather than three, for the AVX-512 walk's
 //! rays to which it applies. A node's critical path, from its rows' loads to the mask of the
 //! children entered, is then a multiply-add and two `max` deep instead of a difference, a
-//! product and three `max`: about a fifth shorter, and the single-ray walk waits on it at every
+//! product and three `max`: about a fifth shorter, and a single ray's walk waits on it at every
 //! node.
 //!
 //! The fused form is not the difference-and-product test rounded differently: `c` is rounded
 //! once per ray, an absolute error that the far scale of Ize (2013), "Robust BVH Ray Traversal",
 //! does not cover when a box lies close to an origin far from the scene's zero. So the constants
-//! carry margins that make the form conservative by construction ([`FusedPlanes::new`]):
+//! are rounded each its safe way ([`FusedPlanes::new`]), which AVX-512's per-instruction rounding
+//! makes as cheap as rounding them to nearest:
 //!
-//! - the near constant is lowered by `2^-20 |origin * inv|` plus the smallest normal float,
-//!   more than the error of making it (subnormal results included), so that a near plane's
-//!   distance is at most the exact one rounded up once: at most `t (1 + 2u)` for any distance
+//! - the near constant is `-origin * inv` rounded down, so a near plane's distance is at most
+//!   the exact `(plane - origin) * inv` rounded up once: at most `t (1 + 3u)` for any distance
 //!   `t >= 0` that the exact-order test ([`super::node::child_entry_scalar`], and the triangle
-//!   block's box correction) finds on a box inside the child, `u` the unit roundoff;
+//!   block's box correction) finds on a box inside the child, `u` being the unit roundoff;
 //! - the far planes' factor is the inverse direction times `1 + 2^-19` and the far constant is
-//!   raised by the same margin, so that a far plane's distance is at least `t (1 + 28u)` for any
-//!   such `t`, where the exact-order exit reaches at most `t (1 + 10u)`; within `reach(t)`, the
-//!   slack the walk allows a box beyond the closest hit, the child is then still entered.
+//!   `-origin * inv_far + 2^-126` rounded up, so that a far plane's distance is at least
+//!   `t (1 + 28u)` for any such `t`, where the exact-order exit reaches at most `t (1 + 10u)`,
+//!   and at least the smallest normal float above the exact distance: a far distance that the
+//!   exact-order test rounds to zero, at an origin on a box's face, stays above a near distance
+//!   of the same plane and above a `t_min` of zero. Within `reach(t)`, the slack the walk allows
+//!   a box beyond the closest hit, the child is then still entered.
 //!
-//! The margins' floor (the smallest normal float) keeps a far distance that the exact-order test
-//! rounds to zero, at an origin on a box's face, from falling below a `t_min` of zero.
-//!
-//! The form applies to rays with `t_min >= 0` (a hit is never behind the origin), whose three
-//! inverse direction components and far factors are finite (no zero direction component, whose
-//! infinite inverse would make `inf - inf`), and whose `|origin * inv|` is below `1e30` (so that
-//! the margins stay finite). No distance is then NaN, so the order in which the four values are
-//! compared does not matter, and the two-step order is taken. Other rays keep the exact-order test,
-//! whose three-step order is the one that skips a NaN distance (see [`super::kernels`]).
+//! The form applies to rays with `t_min >= 0` (a hit is never behind the origin) whose inverse
+//! direction components' far factors and their products with the origin are below `1e38` ([`applies`]:
+//! no zero direction component, whose infinite inverse would make `inf - inf`, and finite
+//! constants). No distance is then NaN, so the order in which the four values are compared does
+//! not matter, and the two-step order is taken. The dispatch gives the other rays the walk with the
+//! exact-order test, whose three-step order is the one that skips a NaN distance (see
+//! [`super::kernels`]); the AVX2 walk keeps it for every ray, its vectors having no per-instruction
+//! rounding.
 //!
 //! The tests below put boxes around two points of a ray, their faces two or three floats out,
-//! inside boxes as large or one float or two larger, at scales from `1e-30` to `1e20`, and check
-//! that every distance the exact-order test accepts on the inner box enters the outer one; they
-//! fail with the margins or the far factor taken out.
+//! and boxes that a ray meets at a corner or along a face, inside boxes as large or a float
+//! larger, at scales from `1e-30` to `1e20`, and check that every distance the exact-order test
+//! accepts on the inner box enters the outer one; they fail with the constants rounded to nearest
+//! or the far factor taken out. The kernel's tests check [`FusedPlanes::new_avx512`] against
+//! [`FusedPlanes::new`] and the kernel against [`child_entry_fused_scalar`], bit for bit.
 
 use glam::Vec3A;
 
 use super::node::{NodeRay, WideNode};
-use crate::Ray;
 
 /// The far planes' factor over the inverse direction: `1 + 2^-19`, exact in `f32`.
 pub const FUSED_FAR_SCALE: f32 = 1.0 + 1.0 / (1 << 19) as f32;
 
-/// The relative part of the constants' margins.
-const MARGIN: f32 = 1.0 / (1 << 20) as f32;
+/// Largest magnitude of an inverse direction's far factor and of its product with the origin
+/// for which the form applies: far enough below the largest float that the constants, rounded
+/// away from the nearest, stay finite.
+const LARGEST: f32 = 1e38;
 
-/// Largest `|origin * inv|` for which the form applies.
-const LARGEST_PRODUCT: f32 = 1e30;
+/// Whether the fused form applies to a ray of origin `origin`, inverse direction `inv_dir` and
+/// start `t_min` (see the module documentation): three-lane vector operations, no branch, cheap
+/// enough for the dispatch to ask before it picks a walk.
+#[inline(always)]
+pub fn applies(origin: Vec3A, inv_dir: Vec3A, t_min: f32) -> bool {
+    let inv_far = inv_dir * FUSED_FAR_SCALE;
+    let bound = Vec3A::splat(LARGEST);
+    // `cmplt` is false for NaN and the infinities: an infinite inverse (a zero direction
+    // component) or product leaves the form out.
+    (inv_far.abs().cmplt(bound) & (origin * inv_far).abs().cmplt(bound)).all() & (t_min >= 0.0)
+}
 
-/// The per-ray constants of the fused node test (see the module documentation).
+/// [`applies`] to the ray `ray` was prepared from.
+#[inline(always)]
+pub fn applies_to(ray: &NodeRay) -> bool {
+    applies(ray.origin.into(), ray.inv_dir.into(), ray.t_min)
+}
+
+/// The per-ray constants of the fused node test (see the module documentation), for a ray to
+/// which the form [`applies`].
 #[derive(Clone, Copy, Debug)]
 pub struct FusedPlanes {
-    /// Per axis, `-origin * inv` lowered by its margin: the near planes' constant.
+    /// Per axis, `-origin * inv` rounded down: the near planes' constant.
     pub near: [f32; 3],
     /// Per axis, the far planes' factor: the inverse direction times [`FUSED_FAR_SCALE`].
     pub inv_far: [f32; 3],
-    /// Per axis, `-origin * inv_far` raised by its margin: the far planes' constant.
+    /// Per axis, `-origin * inv_far + 2^-126` rounded up: the far planes' constant.
     pub far: [f32; 3],
-    /// Whether the form applies to the ray (see the module documentation); the constants mean
-    /// nothing where it does not.
-    pub applies: bool,
 }
 
 impl FusedPlanes {
-    /// The constants of `ray`, made with three-lane vectors and no branch.
-    #[inline(always)]
-    pub fn new(ray: &Ray) -> Self {
-        let (o, inv) = (ray.origin_a(), ray.inv_dir_a());
-        let inv_far = inv * FUSED_FAR_SCALE;
-        let (near, far) = (-(o * inv), -(o * inv_far));
-        let margin = |c: Vec3A| c.abs() * MARGIN + Vec3A::splat(f32::MIN_POSITIVE);
-        let finite = inv_far.abs().cmplt(Vec3A::INFINITY)
-            & near.abs().cmplt(Vec3A::splat(LARGEST_PRODUCT))
-            & far.abs().cmplt(Vec3A::splat(LARGEST_PRODUCT));
-        FusedPlanes {
-            near: (near - margin(near)).to_array(),
-            inv_far: inv_far.to_array(),
-            far: (far + margin(far)).to_array(),
-            applies: finite.all() & (ray.t_min >= 0.0),
+    /// Constants that no ray has: what a fused kernel holds before its walk prepares it.
+    pub const NONE: FusedPlanes = FusedPlanes { near: [0.0; 3], inv_far: [0.0; 3], far: [0.0; 3] };
+
+    /// The constants of `ray`, each product computed exactly in `f64` and rounded its way: the
+    /// reference [`FusedPlanes::new_avx512`] matches bit for bit.
+    pub fn new(ray: &NodeRay) -> Self {
+        debug_assert!(applies_to(ray));
+        let mut planes = FusedPlanes::NONE;
+        for a in 0..3 {
+            let (o, inv) = (ray.origin[a], ray.inv_dir[a]);
+            let inv_far = inv * FUSED_FAR_SCALE;
+            // Products of two floats are exact in `f64`, and so is the far constant's sum unless
+            // its terms lie more than 53 bits apart.
+            planes.near[a] = round_down(-(o as f64) * inv as f64);
+            planes.inv_far[a] = inv_far;
+            let product = -(o as f64) * inv_far as f64;
+            let sum = product + f32::MIN_POSITIVE as f64;
+            planes.far[a] = if sum - product == f32::MIN_POSITIVE as f64 {
+                round_up(sum)
+            } else {
+                // The sum was rounded: the product is so large that the float above it is
+                // above the sum too.
+                let above = round_up(product);
+                if above as f64 == product { above.next_up() } else { above }
+            };
         }
+        planes
     }
+
+    /// [`FusedPlanes::new`] with AVX-512's per-instruction rounding: each constant one scalar
+    /// product or multiply-add rounded down or up, no longer to make than rounded to nearest.
+    ///
+    /// # Safety
+    /// The processor has AVX-512 F and VL.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma,avx512f,avx512vl")]
+    #[inline]
+    pub unsafe fn new_avx512(ray: &NodeRay) -> Self {
+        use std::arch::x86_64::*;
+        const DOWN: i32 = _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC;
+        const UP: i32 = _MM_FROUND_TO_POS_INF | _MM_FROUND_NO_EXC;
+        let mut planes = FusedPlanes::NONE;
+        let floor = _mm_set_ss(f32::MIN_POSITIVE);
+        for a in 0..3 {
+            let (o, inv) = (_mm_set_ss(-ray.origin[a]), _mm_set_ss(ray.inv_dir[a]));
+            let inv_far = _mm_mul_ss(inv, _mm_set_ss(FUSED_FAR_SCALE));
+            planes.near[a] = _mm_cvtss_f32(_mm_mul_round_ss::<DOWN>(o, inv));
+            planes.inv_far[a] = _mm_cvtss_f32(inv_far);
+            planes.far[a] = _mm_cvtss_f32(_mm_fmadd_round_ss::<UP>(o, inv_far, floor));
+        }
+        planes
+    }
+}
+
+/// The largest `f32` at most `x`.
+fn round_down(x: f64) -> f32 {
+    let f = x as f32;
+    if f as f64 > x { f.next_down() } else { f }
+}
+
+/// The smallest `f32` at least `x`.
+fn round_up(x: f64) -> f32 {
+    let f = x as f32;
+    if (f as f64) < x { f.next_up() } else { f }
 }
 
 /// `if a > b { a } else { b }`: the kernels' `max`, and with no NaN the larger of the two.
@@ -96,20 +161,30 @@ fn less(a: f32, b: f32) -> f32 {
     if a < b { a } else { b }
 }
 
-/// The fused test of one child: the reference the fused SIMD kernels match bit for bit, for a ray
-/// to which the form applies. Returns the entry distance if the ray enters the box within
-/// `t_min..=limit`.
-pub fn child_entry_fused_scalar(node: &WideNode, slot: usize, ray: &NodeRay, limit: f32) -> Option<f32> {
-    let (enter, exit) = child_distances_fused_scalar(node, slot, ray, limit);
+/// The fused test of one child with the constants `planes`: the reference the fused SIMD kernel
+/// matches bit for bit, for a ray to which the form applies. Returns the entry distance if the ray
+/// enters the box within `t_min..=limit`.
+pub fn child_entry_fused_scalar(
+    node: &WideNode,
+    slot: usize,
+    ray: &NodeRay,
+    planes: &FusedPlanes,
+    limit: f32,
+) -> Option<f32> {
+    let (enter, exit) = child_distances_fused_scalar(node, slot, ray, planes, limit);
     (enter <= exit).then_some(enter)
 }
 
-/// The fused test's entry and exit distances of one child, in the kernels' order.
-pub fn child_distances_fused_scalar(node: &WideNode, slot: usize, ray: &NodeRay, limit: f32) -> (f32, f32) {
-    debug_assert!(ray.fused.applies);
-    let p = &ray.fused;
-    let near = |a: usize| node.bounds[ray.row_index(a, 0)][slot].mul_add(ray.inv_dir[a], p.near[a]);
-    let far = |a: usize| node.bounds[ray.row_index(a, 1)][slot].mul_add(p.inv_far[a], p.far[a]);
+/// The fused test's entry and exit distances of one child, in the kernel's order.
+pub fn child_distances_fused_scalar(
+    node: &WideNode,
+    slot: usize,
+    ray: &NodeRay,
+    planes: &FusedPlanes,
+    limit: f32,
+) -> (f32, f32) {
+    let near = |a: usize| node.bounds[ray.row_index(a, 0)][slot].mul_add(ray.inv_dir[a], planes.near[a]);
+    let far = |a: usize| node.bounds[ray.row_index(a, 1)][slot].mul_add(planes.inv_far[a], planes.far[a]);
     let enter = greater(greater(near(0), near(1)), greater(near(2), ray.t_min));
     let exit = less(less(far(0), far(1)), less(far(2), limit));
     (enter, exit)
@@ -122,9 +197,9 @@ mod tests {
     use rand_pcg::Pcg32;
 
     use super::*;
-    use crate::Aabb;
     use crate::accel::wide::node::reach;
     use crate::geom::aabb::ROBUST_FAR_SCALE;
+    use crate::{Aabb, Ray};
 
     /// The box correction of the triangle block test (`triangles::intersect_block`), one box: the
     /// interval of distances a hit in the box may be given, in the exact-order form.
@@ -160,11 +235,12 @@ mod tests {
         let mut node = WideNode::EMPTY_NODE;
         node.set_child(2, outer, 0, 0);
         let r = NodeRay::new(ray);
-        assert!(r.fused.applies, "{ray:?}");
+        assert!(applies(ray.origin_a(), ray.inv_dir_a(), ray.t_min), "{ray:?}");
+        let planes = FusedPlanes::new(&r);
         for t in [lo, hi] {
             let limit = reach(t);
             let entry = if fused {
-                child_entry_fused_scalar(&node, 2, &r, limit)
+                child_entry_fused_scalar(&node, 2, &r, &planes, limit)
             } else {
                 crate::accel::wide::node::child_entry_scalar(&node, 2, &r, limit)
             };
@@ -211,7 +287,7 @@ mod tests {
             let outer = Aabb::new(inner.min.map(|x| nudge(x, -grow)), inner.max.map(|x| nudge(x, grow)));
             let t_max = [f32::INFINITY, t1.max(t2), 2.0 * scale][i % 3];
             let ray = Ray::segment(origin, dir, 0.0, t_max);
-            if !ray.is_valid() || !NodeRay::new(&ray).fused.applies {
+            if !ray.is_valid() || !applies(ray.origin_a(), ray.inv_dir_a(), ray.t_min) {
                 continue;
             }
             if holds(&inner, &outer, &ray, true) {
@@ -249,7 +325,7 @@ mod tests {
             let grow = [0, 0, 1][i % 3];
             let outer = Aabb::new(inner.min.map(|x| nudge(x, -grow)), inner.max.map(|x| nudge(x, grow)));
             let ray = Ray::segment(origin, corner - origin, 0.0, [f32::INFINITY, 1.0][i % 2]);
-            if !ray.is_valid() || !NodeRay::new(&ray).fused.applies {
+            if !ray.is_valid() || !applies(ray.origin_a(), ray.inv_dir_a(), ray.t_min) {
                 continue;
             }
             if holds(&inner, &outer, &ray, true) {
@@ -262,14 +338,19 @@ mod tests {
 
     #[test]
     fn the_form_applies_only_where_its_bounds_hold() {
-        let applies = |o: Vec3, d: Vec3, t_min: f32| FusedPlanes::new(&Ray::segment(o, d, t_min, 1e30)).applies;
+        let applies = |o: Vec3, d: Vec3, t_min: f32| {
+            let ray = Ray::segment(o, d, t_min, 1e30);
+            applies(ray.origin_a(), ray.inv_dir_a(), ray.t_min)
+        };
         assert!(applies(Vec3::new(1.0, -2.0, 3.0), Vec3::new(0.5, 1.0, -2.0), 0.0));
         assert!(applies(Vec3::ZERO, Vec3::ONE, -0.0));
         // A zero component (an infinite inverse), a tiny one whose inverse overflows, a negative
-        // start, an origin so far out that its product with the inverse passes 1e30.
+        // start, an origin so far out that its product with the inverse overflows.
         assert!(!applies(Vec3::ZERO, Vec3::new(1.0, 0.0, 1.0), 0.0));
         assert!(!applies(Vec3::ZERO, Vec3::new(1.0, 1e-39, 1.0), 0.0));
         assert!(!applies(Vec3::ZERO, Vec3::ONE, -1.0));
-        assert!(!applies(Vec3::new(1e20, 0.0, 0.0), Vec3::new(1e-11, 1.0, 1.0), 0.0));
+        assert!(!applies(Vec3::new(-1e30, 0.0, 0.0), Vec3::new(1e-20, 1.0, 1.0), 0.0));
+        assert!(!applies(Vec3::new(1e30, 0.0, 0.0), Vec3::new(-1e-9, 1.0, 1.0), 0.0));
+        assert!(applies(Vec3::new(1e30, 0.0, 0.0), Vec3::new(-1e-7, 1.0, 1.0), 0.0));
     }
 }

@@ -22,6 +22,18 @@ pub trait NodeKernel: Copy {
     /// does ([`super::triangles::TriRay::new_avx`]). False unless a kernel says so.
     const AVX: bool = false;
 
+    /// The kernel made ready for one query's ray: a kernel with per-ray constants makes them
+    /// here, at the start of the walk, in the function compiled for its instruction set, so
+    /// that they reach the walk in registers. The kernel itself by default.
+    ///
+    /// # Safety
+    /// As [`NodeKernel::children`].
+    #[inline(always)]
+    unsafe fn for_ray(self, ray: &NodeRay) -> Self {
+        let _ = ray;
+        self
+    }
+
     /// Tests the ray against the eight children's boxes within `t_min..=limit`: bit `i` of the
     /// result is set if child `i` is entered, and `dist[i]` is then its entry distance.
     ///
@@ -79,12 +91,13 @@ fn portable_slabs<const EXITS: bool>(node: &WideNode, ray: &NodeRay, limit: f32,
 }
 
 #[cfg(target_arch = "x86_64")]
-pub use x86::{Avx2, Avx2Fused, Avx512, Avx512Fused};
+pub use x86::{Avx2, Avx512, Avx512Fused};
 
 #[cfg(target_arch = "x86_64")]
 mod x86 {
     use std::arch::x86_64::*;
 
+    use super::super::fused::FusedPlanes;
     use super::{NodeKernel, NodeRay, WIDTH, WideNode};
 
     /// Eight lanes with AVX2.
@@ -172,11 +185,10 @@ mod x86 {
     /// for a ray to which it applies: a multiply-add per plane, the four entries and the four
     /// exits each reduced in two steps.
     #[inline(always)]
-    unsafe fn slabs_fused(node: &WideNode, ray: &NodeRay, limit: f32) -> (__m256, __m256) {
+    unsafe fn slabs_fused(node: &WideNode, ray: &NodeRay, p: &FusedPlanes, limit: f32) -> (__m256, __m256) {
         // SAFETY (for the whole function): the caller guarantees AVX2 and FMA; the loads as in
         // `slabs`.
         unsafe {
-            let p = &ray.fused;
             // A loop rather than closures: a closure is compiled without the caller's target
             // features, and its intrinsics would become calls.
             let (mut near, mut far) = ([_mm256_setzero_ps(); 3], [_mm256_setzero_ps(); 3]);
@@ -193,49 +205,28 @@ mod x86 {
         }
     }
 
-    /// The fused node test ([`super::super::fused`]) with AVX2 and FMA, for the rays to which it
-    /// applies; the dispatch gives the others [`Avx2`].
+    /// The fused node test ([`super::super::fused`]) with AVX-512 (VL), for the rays to which
+    /// it applies (the dispatch gives the others [`Avx512`]). It carries its ray's constants,
+    /// made by [`NodeKernel::for_ray`] at the start of the walk, in the walk's own function, so
+    /// that they reach it in registers.
     #[derive(Clone, Copy, Debug)]
-    pub struct Avx2Fused;
-
-    impl NodeKernel for Avx2Fused {
-        const AVX: bool = true;
-
-        #[inline(always)]
-        unsafe fn children(self, node: &WideNode, ray: &NodeRay, limit: f32, dist: &mut [f32; WIDTH]) -> u32 {
-            // SAFETY: AVX2 and FMA are guaranteed by the caller; `dist` holds eight floats.
-            unsafe {
-                let (enter, exit) = slabs_fused(node, ray, limit);
-                _mm256_storeu_ps(dist.as_mut_ptr(), enter);
-                _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(enter, exit)) as u32
-            }
-        }
-
-        #[inline(always)]
-        unsafe fn children_exits(self, node: &WideNode, ray: &NodeRay, limit: f32, dist: &mut [f32; WIDTH]) -> u32 {
-            // SAFETY: as in `children`.
-            unsafe {
-                let (enter, exit) = slabs_fused(node, ray, limit);
-                _mm256_storeu_ps(dist.as_mut_ptr(), exit);
-                _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(enter, exit)) as u32
-            }
-        }
-    }
-
-    /// The fused node test with AVX-512 (VL), for the rays to which it applies; the dispatch
-    /// gives the others [`Avx512`].
-    #[derive(Clone, Copy, Debug)]
-    pub struct Avx512Fused;
+    pub struct Avx512Fused(pub FusedPlanes);
 
     impl NodeKernel for Avx512Fused {
         const AVX: bool = true;
+
+        #[inline(always)]
+        unsafe fn for_ray(self, ray: &NodeRay) -> Self {
+            // SAFETY: the caller's guarantee: AVX-512 F and VL.
+            Avx512Fused(unsafe { FusedPlanes::new_avx512(ray) })
+        }
 
         #[inline(always)]
         unsafe fn children(self, node: &WideNode, ray: &NodeRay, limit: f32, dist: &mut [f32; WIDTH]) -> u32 {
             // SAFETY: AVX-512 F and VL (and FMA) are guaranteed by the caller; `dist` holds eight
             // floats.
             unsafe {
-                let (enter, exit) = slabs_fused(node, ray, limit);
+                let (enter, exit) = slabs_fused(node, ray, &self.0, limit);
                 _mm256_storeu_ps(dist.as_mut_ptr(), enter);
                 _mm256_cmp_ps_mask::<_CMP_LE_OQ>(enter, exit) as u32
             }
@@ -245,7 +236,7 @@ mod x86 {
         unsafe fn children_exits(self, node: &WideNode, ray: &NodeRay, limit: f32, dist: &mut [f32; WIDTH]) -> u32 {
             // SAFETY: as in `children`.
             unsafe {
-                let (enter, exit) = slabs_fused(node, ray, limit);
+                let (enter, exit) = slabs_fused(node, ray, &self.0, limit);
                 _mm256_storeu_ps(dist.as_mut_ptr(), exit);
                 _mm256_cmp_ps_mask::<_CMP_LE_OQ>(enter, exit) as u32
             }
@@ -260,7 +251,7 @@ mod tests {
     use rand_pcg::Pcg32;
 
     use super::*;
-    use crate::accel::wide::fused::{child_distances_fused_scalar, child_entry_fused_scalar};
+    use crate::accel::wide::fused::{FusedPlanes, applies_to, child_distances_fused_scalar, child_entry_fused_scalar};
     use crate::accel::wide::isa::Isa;
     use crate::accel::wide::node::{child_entry_scalar, reach};
     use crate::{Aabb, Ray};
@@ -311,46 +302,38 @@ mod tests {
             }
             assert_eq!(exits[slot].to_bits(), exit.to_bits(), "{isa}: slot {slot} of {node:?}, {ray:?}");
         }
-        if r.fused.applies {
-            check_fused(isa, node, ray, &r, limit);
+        #[cfg(target_arch = "x86_64")]
+        if isa == Isa::Avx512 && applies_to(&r) {
+            // SAFETY: the AVX-512 instruction set is available.
+            let planes = unsafe { FusedPlanes::new_avx512(&r) };
+            let reference = FusedPlanes::new(&r);
+            for (got, expected) in
+                [(planes.near, reference.near), (planes.inv_far, reference.inv_far), (planes.far, reference.far)]
+            {
+                assert_eq!(got.map(f32::to_bits), expected.map(f32::to_bits), "{ray:?}");
+            }
+            check_fused(node, ray, &r, &planes, limit);
         }
         mask.count_ones()
     }
 
-    /// The fused kernel of `isa` (none for the portable one) against the fused scalar test, bit
-    /// for bit, entries and exits.
-    fn check_fused(isa: Isa, node: &WideNode, ray: &Ray, r: &NodeRay, limit: f32) {
+    /// The fused kernel against the fused scalar test, bit for bit, entries and exits.
+    #[cfg(target_arch = "x86_64")]
+    fn check_fused(node: &WideNode, ray: &Ray, r: &NodeRay, planes: &FusedPlanes, limit: f32) {
         let (mut entries, mut exits) = ([0.0; WIDTH], [0.0; WIDTH]);
-        // SAFETY: as in `check`.
+        let kernel = Avx512Fused(*planes);
+        // SAFETY: as in `check`: called only where AVX-512 is available.
         let (mask, exit_mask) = unsafe {
-            match isa {
-                Isa::Portable => return,
-                #[cfg(target_arch = "x86_64")]
-                Isa::Avx2 => (
-                    Avx2Fused.children(node, r, limit, &mut entries),
-                    Avx2Fused.children_exits(node, r, limit, &mut exits),
-                ),
-                #[cfg(target_arch = "x86_64")]
-                Isa::Avx512 => (
-                    Avx512Fused.children(node, r, limit, &mut entries),
-                    Avx512Fused.children_exits(node, r, limit, &mut exits),
-                ),
-                #[cfg(not(target_arch = "x86_64"))]
-                _ => unreachable!(),
-            }
+            (kernel.children(node, r, limit, &mut entries), kernel.children_exits(node, r, limit, &mut exits))
         };
-        assert_eq!(exit_mask, mask, "{isa}, fused: {node:?}, {ray:?}");
+        assert_eq!(exit_mask, mask, "fused: {node:?}, {ray:?}");
         for slot in 0..WIDTH {
-            let expected = child_entry_fused_scalar(node, slot, r, limit);
+            let expected = child_entry_fused_scalar(node, slot, r, planes, limit);
             let got = (mask >> slot & 1 != 0).then_some(entries[slot]);
-            assert_eq!(
-                expected.map(f32::to_bits),
-                got.map(f32::to_bits),
-                "{isa}, fused: slot {slot} of {node:?}, {ray:?}"
-            );
+            assert_eq!(expected.map(f32::to_bits), got.map(f32::to_bits), "fused: slot {slot} of {node:?}, {ray:?}");
             if got.is_some() {
-                let exit = child_distances_fused_scalar(node, slot, r, limit).1;
-                assert_eq!(exits[slot].to_bits(), exit.to_bits(), "{isa}, fused: slot {slot} of {node:?}, {ray:?}");
+                let exit = child_distances_fused_scalar(node, slot, r, planes, limit).1;
+                assert_eq!(exits[slot].to_bits(), exit.to_bits(), "fused: slot {slot} of {node:?}, {ray:?}");
             }
         }
     }

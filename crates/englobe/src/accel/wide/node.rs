@@ -12,7 +12,6 @@
 //! with the number of items in [`WideNode::counts`]. Unused slots have [`EMPTY`] and an empty box
 //! (`+inf` below, `-inf` above) that no ray enters: the slab test rejects it without a special case.
 
-use super::fused::FusedPlanes;
 use crate::geom::aabb::ROBUST_FAR_SCALE;
 use crate::{Aabb, Ray};
 
@@ -113,19 +112,21 @@ pub struct NodeRay {
     pub inv_far: [f32; 3],
     /// The ray's `t_min`.
     pub t_min: f32,
-    /// The constants of the fused node test, and whether it applies to the ray
-    /// ([`super::fused`]).
-    pub fused: FusedPlanes,
     /// Byte offset of the near row of each axis in [`WideNode::bounds`], for kernels that load
     /// rows without an index check; the far row is the axis's other one, at `near ^ ROW_BYTES`
     /// (rows `2a` and `2a + 1` differ in that bit alone), so that a query makes three offsets
     /// rather than six. Private, so that only [`NodeRay::new`] makes them, always below
     /// `ROWS * WIDTH * 4`.
-    row_bytes: [u32; 3],
+    ///
+    /// Each a `usize`, not a `u32`: the walk loads them one by one, and the compiler has been
+    /// seen to join the loads of two adjacent `u32`s into one, which then spans two of the
+    /// stores that made them and cannot take its value from them (a store-forwarding stall at
+    /// the start of every query).
+    row_bytes: [usize; 3],
 }
 
 /// Bytes of one row of [`WideNode::bounds`].
-const ROW_BYTES: u32 = (WIDTH * 4) as u32;
+const ROW_BYTES: usize = WIDTH * 4;
 const _: () = assert!(ROW_BYTES.is_power_of_two(), "the far row is found by flipping one bit");
 
 impl NodeRay {
@@ -136,13 +137,12 @@ impl NodeRay {
         // Bit `a` set if the ray goes down axis `a` (`!(inv >= 0)`, as the scalar slab test
         // decides it; the inverse of a zero component is `+inf`, never `-inf`).
         let down = inv.cmplt(glam::Vec3::ZERO).bitmask();
-        let near = |a: u32| (2 * a + ((down >> a) & 1)) * ROW_BYTES;
+        let near = |a: usize| (2 * a + ((down as usize >> a) & 1)) * ROW_BYTES;
         NodeRay {
             origin: ray.origin().to_array(),
             inv_dir: inv.to_array(),
             inv_far: (inv * ROBUST_FAR_SCALE).to_array(),
             t_min: ray.t_min,
-            fused: FusedPlanes::new(ray),
             row_bytes: [near(0), near(1), near(2)],
         }
     }
@@ -150,14 +150,14 @@ impl NodeRay {
     /// Byte offset of the near (`side` 0) or far (`side` 1) row of `axis` (only the lowest bit of
     /// `side` counts, so that the offset stays within `bounds` whatever it is).
     #[inline(always)]
-    fn row_offset(&self, axis: usize, side: usize) -> u32 {
-        self.row_bytes[axis] ^ ((side as u32 & 1) * ROW_BYTES)
+    fn row_offset(&self, axis: usize, side: usize) -> usize {
+        self.row_bytes[axis] ^ ((side & 1) * ROW_BYTES)
     }
 
     /// Row of the near (`side` 0) or far (`side` 1) plane of `axis` in [`WideNode::bounds`].
     #[inline(always)]
     pub fn row_index(&self, axis: usize, side: usize) -> usize {
-        (self.row_offset(axis, side) / ROW_BYTES) as usize
+        self.row_offset(axis, side) / ROW_BYTES
     }
 }
 
@@ -166,7 +166,7 @@ impl NodeRay {
     #[inline(always)]
     pub fn row<'a>(&self, node: &'a WideNode, axis: usize, side: usize) -> &'a [f32; WIDTH] {
         debug_assert!(axis < 3 && side < 2);
-        let offset = self.row_offset(axis, side) as usize;
+        let offset = self.row_offset(axis, side);
         // SAFETY: `NodeRay::new`, the only maker of `row_bytes`, gives each the start of a row of
         // `bounds` (row < ROWS), a multiple of a row's size, and `row_offset` at most flips it to
         // the other row of the same axis; rows are arrays of WIDTH floats.

@@ -209,6 +209,8 @@ pub unsafe fn closest<K: NodeKernel, C: Counters, L: Leaves<C>>(
     leaves: &mut L,
     counters: &mut C,
 ) {
+    // SAFETY: the caller's guarantee.
+    let kernel = unsafe { kernel.for_ray(ray) };
     let mut inline = [const { MaybeUninit::<Entry>::uninit() }; INLINE_ENTRIES];
     let mut deep = Vec::new();
     let stack = stack_for(depth, &mut inline, &mut deep);
@@ -353,6 +355,8 @@ pub unsafe fn any<K: NodeKernel, C: Counters, L: Leaves<C>>(
     leaves: &mut L,
     counters: &mut C,
 ) -> bool {
+    // SAFETY: the caller's guarantee.
+    let kernel = unsafe { kernel.for_ray(ray) };
     let mut inline = [const { MaybeUninit::<Entry>::uninit() }; INLINE_ENTRIES];
     let mut deep = Vec::new();
     let stack = stack_for(depth, &mut inline, &mut deep);

@@ -12,6 +12,7 @@
 //! test's eight-wide constants again every time the walk came back from a leaf to a node.
 
 use super::dispatch::{self, RayQuery};
+use super::fused;
 use super::isa::Isa;
 use super::kernels::NodeKernel;
 use super::node::{NodeRay, WideNode, reach};
@@ -56,16 +57,16 @@ impl<C: Counters, F: HitFilter<Hit>> RayQuery for Any<'_, C, F> {
     type Output = bool;
 
     #[inline(always)]
-    fn ray(&self) -> &Ray {
-        self.ray
+    fn fused(&self) -> bool {
+        fused::applies(self.ray.origin_a(), self.ray.inv_dir_a(), self.ray.t_min)
     }
 
     #[inline(always)]
-    unsafe fn run<K: NodeKernel>(self, kernel: K, node_ray: NodeRay) -> bool {
+    unsafe fn run<K: NodeKernel>(self, kernel: K) -> bool {
         let Any { bvh, ray, counters, filter } = self;
         debug_assert!(ray.is_valid() && !bvh.nodes().is_empty());
         // SAFETY: `run`'s guarantee.
-        let mut walk = unsafe { TreeWalk::new(kernel, bvh, ray, node_ray, counters) };
+        let mut walk = unsafe { TreeWalk::new(kernel, bvh, ray, counters) };
         triangle_leaves::any_hit_with(bvh.blocks(), ray, ray.t_max, filter, &mut walk)
     }
 }
@@ -83,19 +84,19 @@ struct TreeWalk<'a, K, C> {
 }
 
 impl<'a, K: NodeKernel, C: Counters> TreeWalk<'a, K, C> {
-    /// The walks of `ray` (prepared as `node_ray`) in `bvh`.
+    /// The walks of `ray` in `bvh`.
     ///
     /// # Safety
     /// As [`NodeKernel::children`]: the walks run compiled with the kernel's target features, on
     /// a processor that has them.
     #[inline(always)]
-    unsafe fn new(kernel: K, bvh: &'a TriangleBvh, ray: &Ray, node_ray: NodeRay, counters: &'a mut C) -> Self {
+    unsafe fn new(kernel: K, bvh: &'a TriangleBvh, ray: &Ray, counters: &'a mut C) -> Self {
         TreeWalk {
             kernel,
             isa: bvh.isa(),
             nodes: bvh.nodes(),
             depth: bvh.depth(),
-            ray: node_ray,
+            ray: NodeRay::new(ray),
             limit: reach(ray.t_max),
             counters,
         }
