@@ -16,7 +16,8 @@
 //!   the exact `(plane - origin) * inv` rounded up once: at most `t (1 + 3u)` for any distance
 //!   `t >= 0` that the exact-order test ([`super::node::child_entry_scalar`], and the triangle
 //!   block's box correction) finds on a box inside the child, `u` being the unit roundoff;
-//! - the far planes' factor is the inverse direction times `1 + 2^-19` and the far constant is
+//! - the far planes' factor is the inverse direction times `1 + 2^-19` (the node test's factor
+//!   in both forms, [`super::node::FAR_SCALE`]) and the far constant is
 //!   `-origin * inv_far + 2^-126` rounded up, so that a far plane's distance is at least
 //!   `t (1 + 28u)` for any such `t`, where the exact-order exit reaches at most `t (1 + 10u)`,
 //!   and at least the smallest normal float above the exact distance: a far distance that the
@@ -42,10 +43,7 @@
 
 use glam::Vec3A;
 
-use super::node::{NodeRay, WideNode};
-
-/// The far planes' factor over the inverse direction: `1 + 2^-19`, exact in `f32`.
-pub const FUSED_FAR_SCALE: f32 = 1.0 + 1.0 / (1 << 19) as f32;
+use super::node::{FAR_SCALE, NodeRay, WideNode};
 
 /// Largest magnitude of an inverse direction's far factor and of its product with the origin
 /// for which the form applies: far enough below the largest float that the constants, rounded
@@ -57,7 +55,7 @@ const LARGEST: f32 = 1e38;
 /// enough for the dispatch to ask before it picks a walk.
 #[inline(always)]
 pub fn applies(origin: Vec3A, inv_dir: Vec3A, t_min: f32) -> bool {
-    let inv_far = inv_dir * FUSED_FAR_SCALE;
+    let inv_far = inv_dir * FAR_SCALE;
     let bound = Vec3A::splat(LARGEST);
     // `cmplt` is false for NaN and the infinities: an infinite inverse (a zero direction
     // component) or product leaves the form out.
@@ -76,15 +74,14 @@ pub fn applies_to(ray: &NodeRay) -> bool {
 pub struct FusedPlanes {
     /// Per axis, `-origin * inv` rounded down: the near planes' constant.
     pub near: [f32; 3],
-    /// Per axis, the far planes' factor: the inverse direction times [`FUSED_FAR_SCALE`].
-    pub inv_far: [f32; 3],
-    /// Per axis, `-origin * inv_far + 2^-126` rounded up: the far planes' constant.
+    /// Per axis, `-origin * inv_far + 2^-126` rounded up: the far planes' constant, with the far
+    /// factor of the node test ([`NodeRay::inv_far`]).
     pub far: [f32; 3],
 }
 
 impl FusedPlanes {
     /// Constants that no ray has: what a fused kernel holds before its walk prepares it.
-    pub const NONE: FusedPlanes = FusedPlanes { near: [0.0; 3], inv_far: [0.0; 3], far: [0.0; 3] };
+    pub const NONE: FusedPlanes = FusedPlanes { near: [0.0; 3], far: [0.0; 3] };
 
     /// The constants of `ray`, each product computed exactly in `f64` and rounded its way: the
     /// reference [`FusedPlanes::new_avx512`] matches bit for bit.
@@ -92,12 +89,10 @@ impl FusedPlanes {
         debug_assert!(applies_to(ray));
         let mut planes = FusedPlanes::NONE;
         for a in 0..3 {
-            let (o, inv) = (ray.origin[a], ray.inv_dir[a]);
-            let inv_far = inv * FUSED_FAR_SCALE;
+            let (o, inv, inv_far) = (ray.origin[a], ray.inv_dir[a], ray.inv_far[a]);
             // Products of two floats are exact in `f64`, and so is the far constant's sum unless
             // its terms lie more than 53 bits apart.
             planes.near[a] = round_down(-(o as f64) * inv as f64);
-            planes.inv_far[a] = inv_far;
             let product = -(o as f64) * inv_far as f64;
             let sum = product + f32::MIN_POSITIVE as f64;
             planes.far[a] = if sum - product == f32::MIN_POSITIVE as f64 {
@@ -113,7 +108,8 @@ impl FusedPlanes {
     }
 
     /// [`FusedPlanes::new`] with AVX-512's per-instruction rounding: each constant one scalar
-    /// product or multiply-add rounded down or up, no longer to make than rounded to nearest.
+    /// multiply-add rounded down or up, from the ray's fields, as quick to make as the product
+    /// rounded to nearest.
     ///
     /// # Safety
     /// The processor has AVX-512 F and VL.
@@ -125,13 +121,13 @@ impl FusedPlanes {
         const DOWN: i32 = _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC;
         const UP: i32 = _MM_FROUND_TO_POS_INF | _MM_FROUND_NO_EXC;
         let mut planes = FusedPlanes::NONE;
-        let floor = _mm_set_ss(f32::MIN_POSITIVE);
+        let (zero, floor) = (_mm_setzero_ps(), _mm_set_ss(f32::MIN_POSITIVE));
         for a in 0..3 {
-            let (o, inv) = (_mm_set_ss(-ray.origin[a]), _mm_set_ss(ray.inv_dir[a]));
-            let inv_far = _mm_mul_ss(inv, _mm_set_ss(FUSED_FAR_SCALE));
-            planes.near[a] = _mm_cvtss_f32(_mm_mul_round_ss::<DOWN>(o, inv));
-            planes.inv_far[a] = _mm_cvtss_f32(inv_far);
-            planes.far[a] = _mm_cvtss_f32(_mm_fmadd_round_ss::<UP>(o, inv_far, floor));
+            let o = _mm_set_ss(ray.origin[a]);
+            let (inv, inv_far) = (_mm_set_ss(ray.inv_dir[a]), _mm_set_ss(ray.inv_far[a]));
+            // `-(o * inv) + 0` and `-(o * inv_far) + 2^-126`, each rounded once, its way.
+            planes.near[a] = _mm_cvtss_f32(_mm_fnmadd_round_ss::<DOWN>(o, inv, zero));
+            planes.far[a] = _mm_cvtss_f32(_mm_fnmadd_round_ss::<UP>(o, inv_far, floor));
         }
         planes
     }
@@ -184,7 +180,7 @@ pub fn child_distances_fused_scalar(
     limit: f32,
 ) -> (f32, f32) {
     let near = |a: usize| node.bounds[ray.row_index(a, 0)][slot].mul_add(ray.inv_dir[a], planes.near[a]);
-    let far = |a: usize| node.bounds[ray.row_index(a, 1)][slot].mul_add(planes.inv_far[a], planes.far[a]);
+    let far = |a: usize| node.bounds[ray.row_index(a, 1)][slot].mul_add(ray.inv_far[a], planes.far[a]);
     let enter = greater(greater(near(0), near(1)), greater(near(2), ray.t_min));
     let exit = less(less(far(0), far(1)), less(far(2), limit));
     (enter, exit)
@@ -310,11 +306,18 @@ mod tests {
             let unit = [2.0f32.powi(-100), 2.0f32.powi(-20), 1.0, 2.0f32.powi(20), 2.0f32.powi(60)][i % 5];
             let int = |rng: &mut Pcg32, n: i32| rng.random_range(-n..=n) as f32 * unit;
             let (origin, corner) = if i % 4 == 0 {
-                // The origin at zero: no margin, the far factor alone. Any corner then gives an
-                // exact direction; one with full mantissas makes the three axes' distances to it
-                // round each its own way.
+                // The origin at zero: exact constants, the far factor alone. Any corner then gives
+                // an exact direction; one with full mantissas makes the three axes' distances to
+                // it round each its own way.
                 let mut full = || (rng.random::<f32>() + 1.0) * unit * [-1.0, 1.0][rng.random_range(0..2)];
                 (Vec3::ZERO, Vec3::new(full(), full(), full()))
+            } else if i % 4 == 2 {
+                // An origin thousands of steps from zero and a few from the corner: `origin * inv`
+                // is a thousand times the distance, and its rounding outweighs the far factor
+                // unless the constants are rounded their ways.
+                let mut int = |n| int(&mut rng, n);
+                let origin = Vec3::new(int(4), int(4), int(4)) + Vec3::new(4093.0, -2039.0, 3067.0) * unit;
+                (origin, origin + Vec3::new(int(3), int(3), int(3)))
             } else {
                 let mut int = |n| int(&mut rng, n);
                 (Vec3::new(int(64), int(64), int(64)), Vec3::new(int(16), int(16), int(16)))

@@ -107,8 +107,8 @@ pub struct NodeRay {
     pub origin: [f32; 3],
     /// Its inverse direction (`+inf` for zero components).
     pub inv_dir: [f32; 3],
-    /// The inverse direction times [`ROBUST_FAR_SCALE`]: the far planes' factor, rounded once per
-    /// ray instead of once per node (see [`child_entry_scalar`]).
+    /// The inverse direction times [`FAR_SCALE`]: the far planes' factor, rounded once per ray
+    /// instead of once per node (see [`child_entry_scalar`]).
     pub inv_far: [f32; 3],
     /// The ray's `t_min`.
     pub t_min: f32,
@@ -124,6 +124,13 @@ pub struct NodeRay {
     /// the start of every query).
     row_bytes: [usize; 3],
 }
+
+/// The far planes' factor over the inverse direction, `1 + 2^-19` (exact in `f32`): more than
+/// the `1 + 2 gamma(3)` that Ize's bound asks of the slab test ([`ROBUST_FAR_SCALE`]), so that the
+/// fused node test can make its far constant from the same factor ([`super::fused`]). A box's
+/// exit is then put at most 2^-19 of its distance further, which changes no traversal measurably.
+pub const FAR_SCALE: f32 = 1.0 + 1.0 / (1 << 19) as f32;
+const _: () = assert!(FAR_SCALE >= ROBUST_FAR_SCALE);
 
 /// Bytes of one row of [`WideNode::bounds`].
 const ROW_BYTES: usize = WIDTH * 4;
@@ -141,7 +148,7 @@ impl NodeRay {
         NodeRay {
             origin: ray.origin().to_array(),
             inv_dir: inv.to_array(),
-            inv_far: (inv * ROBUST_FAR_SCALE).to_array(),
+            inv_far: (inv * FAR_SCALE).to_array(),
             t_min: ray.t_min,
             row_bytes: [near(0), near(1), near(2)],
         }
@@ -198,7 +205,7 @@ pub fn may_enter(bounds: &Aabb, ray: &Ray, limit: f32) -> bool {
     let down = inv.cmplt(Vec3A::ZERO);
     let (lo, hi) = (Vec3A::from(bounds.min) - o, Vec3A::from(bounds.max) - o);
     let near = Vec3A::select(down, hi, lo) * inv;
-    let far = Vec3A::select(down, lo, hi) * (inv * ROBUST_FAR_SCALE);
+    let far = Vec3A::select(down, lo, hi) * (inv * FAR_SCALE);
     let near = Vec3A::select(near.is_nan_mask(), Vec3A::NEG_INFINITY, near);
     let far = Vec3A::select(far.is_nan_mask(), Vec3A::INFINITY, far);
     let enter = near.max_element();

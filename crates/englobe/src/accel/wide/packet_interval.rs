@@ -28,9 +28,8 @@
 
 use glam::Vec3A;
 
-use super::node::{ROWS, WIDTH, WideNode};
+use super::node::{FAR_SCALE, ROWS, WIDTH, WideNode};
 use crate::Ray;
-use crate::geom::aabb::ROBUST_FAR_SCALE;
 
 /// The bounds of a packet's rays for the interval test of a node's children.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -45,7 +44,7 @@ pub struct PacketInterval {
     far_origin: [f32; 3],
     /// Per axis, the least and the greatest inverse direction.
     inv: [[f32; 2]; 3],
-    /// Per axis, the least and the greatest far factor (`inv * ROBUST_FAR_SCALE`, as each ray
+    /// Per axis, the least and the greatest far factor (`inv * FAR_SCALE`, as each ray
     /// rounds it: rounding keeps the order).
     inv_far: [[f32; 2]; 3],
     /// The least `t_min` of the rays.
@@ -83,7 +82,7 @@ impl PacketInterval {
     pub(super) fn from_bounds(down: u32, origin: [Vec3A; 2], inv: [Vec3A; 2], t_min: f32) -> Self {
         let ([o_lo, o_hi], [inv_lo, inv_hi]) = (origin, inv);
         let going_down = |a: usize| down >> a & 1 != 0;
-        let (inv_far_lo, inv_far_hi) = (inv_lo * ROBUST_FAR_SCALE, inv_hi * ROBUST_FAR_SCALE);
+        let (inv_far_lo, inv_far_hi) = (inv_lo * FAR_SCALE, inv_hi * FAR_SCALE);
         // The arrays spelled out: `[0, 1, 2].map` compiled to calls.
         let down_or_up = |a: usize, down: Vec3A, up: Vec3A| if going_down(a) { down[a] } else { up[a] };
         PacketInterval {

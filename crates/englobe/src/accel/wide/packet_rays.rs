@@ -7,6 +7,7 @@
 
 use glam::{BVec4A, Vec3A, Vec4};
 
+use super::node::FAR_SCALE;
 use super::packet_interval::PacketInterval;
 use crate::geom::aabb::ROBUST_FAR_SCALE;
 use crate::{Aabb, Ray};
@@ -103,7 +104,7 @@ impl PacketRays {
                 o.write_to_slice(&mut p.origin[a].0[lanes.clone()]);
                 d.write_to_slice(&mut p.dir[a].0[lanes.clone()]);
                 inv.write_to_slice(&mut p.inv_dir[a].0[lanes.clone()]);
-                (inv * ROBUST_FAR_SCALE).write_to_slice(&mut p.inv_far[a].0[lanes.clone()]);
+                (inv * FAR_SCALE).write_to_slice(&mut p.inv_far[a].0[lanes.clone()]);
                 p.down[a] |= inv.cmplt(Vec4::ZERO).bitmask() << (4 * k);
             }
             let interval = |j: usize| ray(j).map_or(Vec4::ZERO, |r| Vec4::new(r.t_min, r.t_max, 0.0, 0.0));

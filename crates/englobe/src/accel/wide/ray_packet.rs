@@ -8,10 +8,10 @@
 
 use glam::{Vec3, Vec4};
 
+use super::node::FAR_SCALE;
 use super::packet_rays::{Lanes, PACKET, PacketRays, nonempty};
 use crate::Ray;
 use crate::accel::Hit;
-use crate::geom::aabb::ROBUST_FAR_SCALE;
 use crate::geom::ray::safe_inverse_lanes;
 
 /// Up to sixteen rays, one row per coordinate: lane `i` of every row is ray `i`. The queries
@@ -81,7 +81,7 @@ impl RayPacket {
                 o.write_to_slice(&mut p.origin[a].0[lanes.clone()]);
                 d.write_to_slice(&mut p.dir[a].0[lanes.clone()]);
                 inv.write_to_slice(&mut p.inv_dir[a].0[lanes.clone()]);
-                (inv * ROBUST_FAR_SCALE).write_to_slice(&mut p.inv_far[a].0[lanes.clone()]);
+                (inv * FAR_SCALE).write_to_slice(&mut p.inv_far[a].0[lanes.clone()]);
                 p.down[a] |= inv.cmplt(Vec4::ZERO).bitmask() << (4 * k);
                 finite &= o.is_finite_mask() & d.is_finite_mask();
                 moving |= d.cmpne(Vec4::ZERO);
