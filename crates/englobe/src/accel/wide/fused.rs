@@ -19,8 +19,9 @@
 //! - the far planes' factor is the inverse direction times `1 + 2^-19` (the node test's factor
 //!   in both forms, [`super::node::FAR_SCALE`]) and the far constant is
 //!   `-origin * inv_far + 2^-126` rounded up, so that a far plane's distance is at least
-//!   `t (1 + 28u)` for any such `t`, where the exact-order exit reaches at most `t (1 + 10u)`,
-//!   and at least the smallest normal float above the exact distance: a far distance that the
+//!   `1 + 30u` times the exact one, where the exact-order test's exit, which bounds the `t` of
+//!   every hit inside, is at most `1 + 10u` times it; and at least the smallest normal float
+//!   above the exact distance: a far distance that the
 //!   exact-order test rounds to zero, at an origin on a box's face, stays above a near distance
 //!   of the same plane and above a `t_min` of zero. Within `reach(t)`, the slack the walk allows
 //!   a box beyond the closest hit, the child is then still entered.

@@ -7,6 +7,9 @@
 //! when either is NaN, which is the scalar test's `if t_near > enter { t_near } else { enter }`;
 //! the portable kernel spells that comparison out, because NEON's `max` propagates NaN instead.
 //!
+//! For the rays to which it applies, the AVX-512 walk tests nodes in a fused form instead
+//! ([`Avx512Fused`], see [`super::fused`]), matched bit for bit by its own scalar reference.
+//!
 //! The kernels are `unsafe` only because the x86 ones need their instruction set: a kernel may be
 //! called only from code compiled with its target features, on a processor that has them, which
 //! the dispatch in [`super::traverse`] guarantees.
