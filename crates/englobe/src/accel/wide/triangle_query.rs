@@ -24,7 +24,10 @@ use crate::accel::{Counters, Hit, HitFilter};
 
 impl TriangleBvh {
     /// [`TriangleBvh::any_hit_filtered`] of a ray the caller checked with [`Ray::is_valid`].
-    #[inline]
+    ///
+    /// Always inlined: its callers' loops keep the ray in registers, and the compiler stopped
+    /// inlining it once the dispatch had a fused copy to choose.
+    #[inline(always)]
     pub(crate) fn any_hit_of_valid<C: Counters, F: HitFilter<Hit>>(
         &self,
         ray: &Ray,
