@@ -249,6 +249,21 @@ mod tests {
         true
     }
 
+    /// [`holds`] for `inner` inside itself grown by `grow` floats on each face, in the fused form
+    /// and then in the exact order, if the ray is valid and the fused form applies to it; true if
+    /// some distance was checked.
+    fn holds_grown(inner: &Aabb, grow: i32, ray: &Ray) -> bool {
+        if !ray.is_valid() || !applies(ray.origin_a(), ray.inv_dir_a(), ray.t_min) {
+            return false;
+        }
+        let outer = Aabb::new(inner.min.map(|x| nudge(x, -grow)), inner.max.map(|x| nudge(x, grow)));
+        let checked = holds(inner, &outer, ray, true);
+        if checked {
+            assert!(holds(inner, &outer, ray, false));
+        }
+        checked
+    }
+
     #[test]
     fn every_box_around_a_hit_the_exact_order_test_accepts_is_entered() {
         let mut rng = Pcg32::seed_from_u64(0xf05e_d5ab);
@@ -279,18 +294,9 @@ mod tests {
                 hi[a] = nudge(hi[a], out());
             }
             let inner = Aabb::new(lo, hi);
-            // The outer box: the same, or a float or more larger on each face.
-            let grow = rng.random_range(0..3);
-            let outer = Aabb::new(inner.min.map(|x| nudge(x, -grow)), inner.max.map(|x| nudge(x, grow)));
             let t_max = [f32::INFINITY, t1.max(t2), 2.0 * scale][i % 3];
             let ray = Ray::segment(origin, dir, 0.0, t_max);
-            if !ray.is_valid() || !applies(ray.origin_a(), ray.inv_dir_a(), ray.t_min) {
-                continue;
-            }
-            if holds(&inner, &outer, &ray, true) {
-                assert!(holds(&inner, &outer, &ray, false));
-                checked += 1;
-            }
+            checked += holds_grown(&inner, rng.random_range(0..3), &ray) as u32;
         }
         assert!(checked > 50_000, "only {checked} boxes checked");
     }
@@ -326,16 +332,8 @@ mod tests {
             let mut size = || int(&mut rng, 4).abs();
             let extent = Vec3::new(size(), size(), size()) * [0.0, 1.0][i % 2];
             let inner = Aabb::new(corner, corner + extent);
-            let grow = [0, 0, 1][i % 3];
-            let outer = Aabb::new(inner.min.map(|x| nudge(x, -grow)), inner.max.map(|x| nudge(x, grow)));
             let ray = Ray::segment(origin, corner - origin, 0.0, [f32::INFINITY, 1.0][i % 2]);
-            if !ray.is_valid() || !applies(ray.origin_a(), ray.inv_dir_a(), ray.t_min) {
-                continue;
-            }
-            if holds(&inner, &outer, &ray, true) {
-                assert!(holds(&inner, &outer, &ray, false));
-                checked += 1;
-            }
+            checked += holds_grown(&inner, [0, 0, 1][i % 3], &ray) as u32;
         }
         assert!(checked > 50_000, "only {checked} boxes checked");
     }
