@@ -40,11 +40,11 @@ pub fn closest<C: Counters, L: Leaves<C>>(
         // SAFETY: as above.
         #[cfg(target_arch = "x86_64")]
         Isa::Avx512 if fused::applies_to(ray) => unsafe {
-            x86::closest_avx512_fused(nodes, depth, start, ray, leaves, counters)
+            x86::closest_avx512(x86::FUSED, nodes, depth, start, ray, leaves, counters)
         },
         // SAFETY: as above.
         #[cfg(target_arch = "x86_64")]
-        Isa::Avx512 => unsafe { x86::closest_avx512(nodes, depth, start, ray, leaves, counters) },
+        Isa::Avx512 => unsafe { x86::closest_avx512(x86::Avx512, nodes, depth, start, ray, leaves, counters) },
         #[cfg(not(target_arch = "x86_64"))]
         _ => unreachable!("x86 instruction sets are never available elsewhere"),
     }
@@ -72,11 +72,11 @@ pub fn any<C: Counters, L: Leaves<C>>(
         // SAFETY: as above.
         #[cfg(target_arch = "x86_64")]
         Isa::Avx512 if fused::applies_to(ray) => unsafe {
-            x86::any_avx512_fused(nodes, depth, start, ray, limit, leaves, counters)
+            x86::any_avx512(x86::FUSED, nodes, depth, start, ray, limit, leaves, counters)
         },
         // SAFETY: as above.
         #[cfg(target_arch = "x86_64")]
-        Isa::Avx512 => unsafe { x86::any_avx512(nodes, depth, start, ray, limit, leaves, counters) },
+        Isa::Avx512 => unsafe { x86::any_avx512(x86::Avx512, nodes, depth, start, ray, limit, leaves, counters) },
         #[cfg(not(target_arch = "x86_64"))]
         _ => unreachable!("x86 instruction sets are never available elsewhere"),
     }
@@ -229,10 +229,10 @@ pub fn ray_query<Q: RayQuery>(isa: Isa, query: Q) -> Q::Output {
         Isa::Avx2 => unsafe { x86::ray_query_avx2(query) },
         // SAFETY: as above.
         #[cfg(target_arch = "x86_64")]
-        Isa::Avx512 if query.fused() => unsafe { x86::ray_query_avx512_fused(query) },
+        Isa::Avx512 if query.fused() => unsafe { x86::ray_query_avx512(x86::FUSED, query) },
         // SAFETY: as above.
         #[cfg(target_arch = "x86_64")]
-        Isa::Avx512 => unsafe { x86::ray_query_avx512(query) },
+        Isa::Avx512 => unsafe { x86::ray_query_avx512(x86::Avx512, query) },
         #[cfg(not(target_arch = "x86_64"))]
         _ => unreachable!("x86 instruction sets are never available elsewhere"),
     }
@@ -305,9 +305,14 @@ mod portable {
 #[cfg(target_arch = "x86_64")]
 mod x86 {
     use super::super::fused::FusedPlanes;
-    use super::super::kernels::{Avx2, Avx512, Avx512Fused};
+    pub use super::super::kernels::Avx512;
+    use super::super::kernels::{Avx2, Avx512Fused};
     use super::super::packet_kernels::{Avx2Packet, Avx512Packet};
     use super::*;
+
+    /// The fused kernel as a walk takes it, its constants made at the walk's start
+    /// ([`NodeKernel::for_ray`]).
+    pub const FUSED: Avx512Fused = Avx512Fused(FusedPlanes::NONE);
 
     /// # Safety
     /// The processor has AVX2, FMA and the bit instructions that come with them (see `Isa`).
@@ -332,19 +337,13 @@ mod x86 {
     }
 
     /// # Safety
-    /// The processor has AVX-512 F, VL, BW and DQ (and AVX2).
+    /// The processor has AVX-512 F, VL, BW and DQ (and AVX2); `kernel` is [`Avx512`], or
+    /// [`FUSED`] for a query whose ray the fused node test applies to. (Generic, so that each
+    /// kernel's walk is a function of its own, with its own registers.)
     #[target_feature(enable = "avx2,fma,bmi1,bmi2,lzcnt,popcnt,avx512f,avx512vl,avx512bw,avx512dq")]
-    pub unsafe fn ray_query_avx512<Q: RayQuery>(query: Q) -> Q::Output {
+    pub unsafe fn ray_query_avx512<K: NodeKernel, Q: RayQuery>(kernel: K, query: Q) -> Q::Output {
         // SAFETY: compiled with AVX-512, which the caller guarantees.
-        unsafe { query.run(Avx512) }
-    }
-
-    /// # Safety
-    /// As [`ray_query_avx512`]; and the fused node test applies to the query's ray.
-    #[target_feature(enable = "avx2,fma,bmi1,bmi2,lzcnt,popcnt,avx512f,avx512vl,avx512bw,avx512dq")]
-    pub unsafe fn ray_query_avx512_fused<Q: RayQuery>(query: Q) -> Q::Output {
-        // SAFETY: compiled with AVX-512, which the caller guarantees.
-        unsafe { query.run(Avx512Fused(FusedPlanes::NONE)) }
+        unsafe { query.run(kernel) }
     }
 
     /// # Safety
@@ -363,9 +362,11 @@ mod x86 {
     }
 
     /// # Safety
-    /// The processor has AVX-512 F, VL, BW and DQ (and AVX2).
+    /// As [`ray_query_avx512`], `kernel` being [`FUSED`] only if the fused node test applies to
+    /// `ray`.
     #[target_feature(enable = "avx2,fma,bmi1,bmi2,lzcnt,popcnt,avx512f,avx512vl,avx512bw,avx512dq")]
-    pub unsafe fn closest_avx512<C: Counters, L: Leaves<C>>(
+    pub unsafe fn closest_avx512<K: NodeKernel, C: Counters, L: Leaves<C>>(
+        kernel: K,
         nodes: &[WideNode],
         depth: u32,
         start: u32,
@@ -374,22 +375,7 @@ mod x86 {
         counters: &mut C,
     ) {
         // SAFETY: compiled with AVX-512, which the caller guarantees.
-        unsafe { traverse::closest(Avx512, nodes, depth, start, ray, leaves, counters) }
-    }
-
-    /// # Safety
-    /// As [`closest_avx512`]; and the fused node test applies to `ray`.
-    #[target_feature(enable = "avx2,fma,bmi1,bmi2,lzcnt,popcnt,avx512f,avx512vl,avx512bw,avx512dq")]
-    pub unsafe fn closest_avx512_fused<C: Counters, L: Leaves<C>>(
-        nodes: &[WideNode],
-        depth: u32,
-        start: u32,
-        ray: &NodeRay,
-        leaves: &mut L,
-        counters: &mut C,
-    ) {
-        // SAFETY: compiled with AVX-512, which the caller guarantees.
-        unsafe { traverse::closest(Avx512Fused(FusedPlanes::NONE), nodes, depth, start, ray, leaves, counters) }
+        unsafe { traverse::closest(kernel, nodes, depth, start, ray, leaves, counters) }
     }
 
     /// # Safety
@@ -409,26 +395,11 @@ mod x86 {
     }
 
     /// # Safety
-    /// The processor has AVX-512 F, VL, BW and DQ (and AVX2).
-    #[target_feature(enable = "avx2,fma,bmi1,bmi2,lzcnt,popcnt,avx512f,avx512vl,avx512bw,avx512dq")]
-    pub unsafe fn any_avx512<C: Counters, L: Leaves<C>>(
-        nodes: &[WideNode],
-        depth: u32,
-        start: u32,
-        ray: &NodeRay,
-        limit: f32,
-        leaves: &mut L,
-        counters: &mut C,
-    ) -> bool {
-        // SAFETY: compiled with AVX-512, which the caller guarantees.
-        unsafe { traverse::any(Avx512, nodes, depth, start, ray, limit, leaves, counters) }
-    }
-
-    /// # Safety
-    /// As [`any_avx512`]; and the fused node test applies to `ray`.
+    /// As [`closest_avx512`].
     #[target_feature(enable = "avx2,fma,bmi1,bmi2,lzcnt,popcnt,avx512f,avx512vl,avx512bw,avx512dq")]
     #[allow(clippy::too_many_arguments)]
-    pub unsafe fn any_avx512_fused<C: Counters, L: Leaves<C>>(
+    pub unsafe fn any_avx512<K: NodeKernel, C: Counters, L: Leaves<C>>(
+        kernel: K,
         nodes: &[WideNode],
         depth: u32,
         start: u32,
@@ -438,7 +409,7 @@ mod x86 {
         counters: &mut C,
     ) -> bool {
         // SAFETY: compiled with AVX-512, which the caller guarantees.
-        unsafe { traverse::any(Avx512Fused(FusedPlanes::NONE), nodes, depth, start, ray, limit, leaves, counters) }
+        unsafe { traverse::any(kernel, nodes, depth, start, ray, limit, leaves, counters) }
     }
 
     /// # Safety

@@ -56,17 +56,22 @@ const LARGEST: f32 = 1e38;
 /// enough for the dispatch to ask before it picks a walk.
 #[inline(always)]
 pub fn applies(origin: Vec3A, inv_dir: Vec3A, t_min: f32) -> bool {
-    let inv_far = inv_dir * FAR_SCALE;
+    applies_with_far(origin, inv_dir * FAR_SCALE, t_min)
+}
+
+/// [`applies`] to the ray `ray` was prepared from, with the far factors it holds.
+#[inline(always)]
+pub fn applies_to(ray: &NodeRay) -> bool {
+    applies_with_far(ray.origin.into(), ray.inv_far.into(), ray.t_min)
+}
+
+/// [`applies`], given the far factors `inv_far` (the inverse direction times [`FAR_SCALE`]).
+#[inline(always)]
+fn applies_with_far(origin: Vec3A, inv_far: Vec3A, t_min: f32) -> bool {
     let bound = Vec3A::splat(LARGEST);
     // `cmplt` is false for NaN and the infinities: an infinite inverse (a zero direction
     // component) or product leaves the form out.
     (inv_far.abs().cmplt(bound) & (origin * inv_far).abs().cmplt(bound)).all() & (t_min >= 0.0)
-}
-
-/// [`applies`] to the ray `ray` was prepared from.
-#[inline(always)]
-pub fn applies_to(ray: &NodeRay) -> bool {
-    applies(ray.origin.into(), ray.inv_dir.into(), ray.t_min)
 }
 
 /// The per-ray constants of the fused node test (see the module documentation), for a ray to
