@@ -19,7 +19,8 @@
 # the binaries in target/ab-bench/bin/, by commit and placement, for the next comparison.
 #
 # Environment (defaults in brackets): ALIGNS ["32 64"], CELLS
-# [primary-closest,random-closest,random-any,bounce-closest], RAYS [500000], RESOLUTION [512],
+# [primary-closest,random-closest,random-any,bounce-closest], LIBRARY [englobe; englobe-packet16
+# times the packet walks], RAYS [500000], RESOLUTION [512],
 # REPS [5], ENGLOBE_SHARED [../shared], SCENES [the bunny, the ogre and the Sponza seen from
 # inside, as harness arguments].
 set -euo pipefail
@@ -76,14 +77,14 @@ for round in $(seq 1 "$rounds"); do
     for align in "${aligns[@]}"; do
         for side in "${order[@]}"; do
             "$work/run-$side-$align" --threads 1 --reps "${REPS:-5}" --build-reps 1 --no-check --quiet \
-                --libraries englobe --cells "$cells" --rays "${RAYS:-500000}" --resolution "${RESOLUTION:-512}" \
+                --libraries "${LIBRARY:-englobe}" --cells "$cells" --rays "${RAYS:-500000}" --resolution "${RESOLUTION:-512}" \
                 --csv "$work/runs/$side-$align-$round.csv" "${scenes[@]}" > /dev/null
         done
     done
     echo "round $round of $rounds done" >&2
 done
 
-echo "A: $1 ($(git rev-parse --short "$1")), B: $2 ($(git rev-parse --short "$2")); $rounds rounds, one thread"
+echo "A: $1 ($(git rev-parse --short "$1")), B: $2 ($(git rev-parse --short "$2")); ${LIBRARY:-englobe}, $rounds rounds, one thread"
 python3 - "$work/runs" "${aligns[@]}" <<'EOF'
 import csv, pathlib, statistics, sys
 from collections import defaultdict

@@ -86,7 +86,7 @@ pub trait Leaves<C: Counters> {
 /// Asks for every child of `node` in `mask` (the ones a ray enters), so that their cache misses
 /// overlap instead of following one another as the walk reaches them; `leaf` asks for a leaf's
 /// first item. A lone child is not asked for: the walk reads it next, so there is nothing for its
-/// miss to overlap with. (The single-ray walks ask for each child as they make its entry, in the
+/// miss to overlap with (but its children's line: [`ask_children_line`]). (The single-ray walks ask for each child as they make its entry, in the
 /// loop over the mask they run anyway.)
 #[inline(always)]
 pub(super) fn prefetch_children_of(nodes: &[WideNode], node: &WideNode, mut mask: u32, leaf: impl Fn(u32)) {
@@ -114,7 +114,7 @@ fn prefetch_child(nodes: &[WideNode], child: u32, leaf: impl Fn(u32)) {
 /// not asked for before (see [`prefetch_children_of`]), and without this its last line would be
 /// read from memory after its planes instead of beside them.
 #[inline(always)]
-fn ask_children_line(node: &WideNode) {
+pub(super) fn ask_children_line(node: &WideNode) {
     prefetch_line(&node.children);
 }
 
