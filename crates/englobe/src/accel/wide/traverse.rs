@@ -85,9 +85,10 @@ pub trait Leaves<C: Counters> {
 
 /// Asks for every child of `node` in `mask` (the ones a ray enters), so that their cache misses
 /// overlap instead of following one another as the walk reaches them; `leaf` asks for a leaf's
-/// first item. A lone child is not asked for: the walk reads it next, so there is nothing for its
-/// miss to overlap with (but its children's line: [`ask_children_line`]). (The single-ray walks ask for each child as they make its entry, in the
-/// loop over the mask they run anyway.)
+/// first item. A lone child is not asked for: the walk reads its planes next, so there is nothing
+/// for their miss to overlap with (its children's line is another matter: [`ask_children_line`]).
+/// (The single-ray walks ask for each child as they make its entry, in the loop over the mask
+/// they run anyway.)
 #[inline(always)]
 pub(super) fn prefetch_children_of(nodes: &[WideNode], node: &WideNode, mut mask: u32, leaf: impl Fn(u32)) {
     if mask & mask.wrapping_sub(1) == 0 {
