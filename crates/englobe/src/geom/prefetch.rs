@@ -22,16 +22,3 @@ pub fn prefetch<T>(items: &[T], index: u32) {
     #[cfg(not(target_arch = "x86_64"))]
     let _ = (items, index);
 }
-
-/// Starts loading the 64-byte line that holds the start of `item` into the cache (a hint).
-#[inline(always)]
-pub fn prefetch_line<T>(item: &T) {
-    // SAFETY: as in `prefetch`: a prefetch never faults and reads nothing into the program.
-    #[cfg(target_arch = "x86_64")]
-    unsafe {
-        use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
-        _mm_prefetch::<_MM_HINT_T0>((item as *const T).cast());
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    let _ = item;
-}

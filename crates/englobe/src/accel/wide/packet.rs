@@ -21,7 +21,7 @@ use std::mem::MaybeUninit;
 
 use super::node::{WIDTH, WideNode, index_of, is_leaf};
 use super::packet_kernels::{ChildHits, Lanes, PacketKernel, PacketRays};
-use super::traverse::{INLINE_DEPTH, ask_children_line, prefetch_children_of};
+use super::traverse::{INLINE_DEPTH, prefetch_children_of};
 use crate::accel::Counters;
 
 /// Entries of the stack: seven per level at most, and the deepest level's eight.
@@ -160,7 +160,6 @@ unsafe fn walk<K: PacketKernel, C: Counters, L: PacketLeaves<C>>(
             debug_assert!((reference as usize) < nodes.len());
             // SAFETY: the caller's guarantee: interior references index `nodes`.
             let node = unsafe { nodes.get_unchecked(reference as usize) };
-            ask_children_line(node);
             for _ in 0..current.count_ones() {
                 counters.node_visited();
                 counters.box_tests(WIDTH as u32);

@@ -34,7 +34,7 @@ use std::mem::MaybeUninit;
 use super::kernels::NodeKernel;
 use super::node::{NodeRay, WIDTH, WideNode, index_of, is_leaf, reach};
 use crate::accel::Counters;
-use crate::geom::prefetch::{prefetch, prefetch_line};
+use crate::geom::prefetch::prefetch;
 
 /// Depth (in wide nodes) up to which the stack lives on the call stack.
 pub const INLINE_DEPTH: usize = 32;
@@ -85,10 +85,9 @@ pub trait Leaves<C: Counters> {
 
 /// Asks for every child of `node` in `mask` (the ones a ray enters), so that their cache misses
 /// overlap instead of following one another as the walk reaches them; `leaf` asks for a leaf's
-/// first item. A lone child is not asked for: the walk reads its planes next, so there is nothing
-/// for their miss to overlap with (its children's line is another matter: [`ask_children_line`]).
-/// (The single-ray walks ask for each child as they make its entry, in the loop over the mask
-/// they run anyway.)
+/// first item. A lone child is not asked for: the walk reads it next, so there is nothing for its
+/// miss to overlap with. (The single-ray walks ask for each child as they make its entry, in the
+/// loop over the mask they run anyway.)
 #[inline(always)]
 pub(super) fn prefetch_children_of(nodes: &[WideNode], node: &WideNode, mut mask: u32, leaf: impl Fn(u32)) {
     if mask & mask.wrapping_sub(1) == 0 {
@@ -108,15 +107,6 @@ fn prefetch_child(nodes: &[WideNode], child: u32, leaf: impl Fn(u32)) {
     } else {
         prefetch(nodes, child);
     }
-}
-
-/// Asks for the line of `node` that holds its children's references, which the walk reads only
-/// after the node test, its result deciding which: a node entered as its parent's lone child was
-/// not asked for before (see [`prefetch_children_of`]), and without this its last line would be
-/// read from memory after its planes instead of beside them.
-#[inline(always)]
-pub(super) fn ask_children_line(node: &WideNode) {
-    prefetch_line(&node.children);
 }
 
 /// The entry of child `slot` of `node`, entered at `dist[slot]`, asked for (see
@@ -241,9 +231,6 @@ pub unsafe fn closest<K: NodeKernel, C: Counters, L: Leaves<C>>(
                 debug_assert!((current.reference as usize) < nodes.len());
                 // SAFETY: the caller's guarantee: interior references index `nodes`.
                 let node = unsafe { nodes.get_unchecked(current.reference as usize) };
-                // The children's line is read only once the test has said which are entered:
-                // asked for now, it comes in beside the planes (see `ask_children_line`).
-                ask_children_line(node);
                 counters.node_visited();
                 counters.box_tests(WIDTH as u32);
                 // SAFETY: the caller's guarantee.
@@ -388,7 +375,6 @@ pub unsafe fn any<K: NodeKernel, C: Counters, L: Leaves<C>>(
                 debug_assert!((current.reference as usize) < nodes.len());
                 // SAFETY: the caller's guarantee: interior references index `nodes`.
                 let node = unsafe { nodes.get_unchecked(current.reference as usize) };
-                ask_children_line(node);
                 counters.node_visited();
                 counters.box_tests(WIDTH as u32);
                 // SAFETY: the caller's guarantee. (`dist`: where the ray leaves each child.)
