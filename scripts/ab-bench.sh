@@ -15,8 +15,12 @@
 #
 # Prints, per cell, the median rays per second of each revision over all its runs, and B/A for
 # each placement (medians over the rounds) with their median: a change is worth as much as what
-# it gains under every placement, not under one. The runs' CSVs stay in target/ab-bench/runs/;
-# the binaries in target/ab-bench/bin/, by commit and placement, for the next comparison.
+# it gains under every placement, not under one. Then the runs paired: B/A of the two binaries of
+# one placement run one after the other in the same round, whose median is less moved by the
+# machine's load drifting from round to round, and how many of those pairs B won: a change that
+# wins about half of them has not been told apart from the noise. The runs' CSVs stay in
+# target/ab-bench/runs/; the binaries in target/ab-bench/bin/, by commit and placement, for the
+# next comparison.
 #
 # Environment (defaults in brackets): ALIGNS ["32 64"], CELLS
 # [primary-closest,random-closest,random-any,bounce-closest], LIBRARY [englobe; englobe-packet16
@@ -91,18 +95,27 @@ from collections import defaultdict
 
 runs, aligns = pathlib.Path(sys.argv[1]), sys.argv[2:]
 rates = defaultdict(list)  # (cell, side, align) -> rays per second of each round
+by_round = {}  # (cell, side, align, round) -> rays per second
 for path in sorted(runs.glob("*.csv")):
-    side, align, _ = path.stem.split("-")
+    side, align, round_ = path.stem.split("-")
     for row in csv.DictReader(path.open()):
         if row["rays"] != "build":
             cell = f'{row["scene"]} {row["rays"]} {row["query"]}'
             rates[cell, side, align].append(float(row["mrays_per_s"]))
+            by_round[cell, side, align, round_] = float(row["mrays_per_s"])
 cells = sorted({cell for cell, _, _ in rates})
 head = f'{"cell":32} {"A Mrays/s":>10} {"B Mrays/s":>10}' + "".join(f' {"B/A " + a:>11}' for a in aligns)
-print(head + f' {"median":>7}')
+print(head + f' {"median":>7} {"paired":>7} {"B won":>7}')
 for cell in cells:
     every = {s: [r for a in aligns for r in rates[cell, s, a]] for s in "AB"}
     ratios = [statistics.median(rates[cell, "B", a]) / statistics.median(rates[cell, "A", a]) for a in aligns]
+    pairs = [
+        b / by_round[cell, "A", a, r]
+        for (c, s, a, r), b in by_round.items()
+        if c == cell and s == "B" and (cell, "A", a, r) in by_round
+    ]
     line = f"{cell:32} {statistics.median(every['A']):10.3f} {statistics.median(every['B']):10.3f}"
-    print(line + "".join(f" {r:11.3f}" for r in ratios) + f" {statistics.median(ratios):7.3f}")
+    won = f"{sum(p > 1 for p in pairs)}/{len(pairs)}"
+    print(line + "".join(f" {r:11.3f}" for r in ratios) + f" {statistics.median(ratios):7.3f}"
+          + f" {statistics.median(pairs):7.3f} {won:>7}")
 EOF
