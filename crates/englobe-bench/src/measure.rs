@@ -1,6 +1,6 @@
 //! Timing: a query set traced by each library on a pool of `n` threads, the rays split into chunks
-//! that the threads take in turn; one untimed warm-up run per library, then `reps` rounds of timed
-//! runs, the libraries taking turns in each, and each library's median. Results are written into
+//! that the threads take in turn; `reps` rounds in which the libraries take turns, each with an
+//! untimed warm-up run and a timed one, and each library's median. Results are written into
 //! buffers allocated once, outside the timed runs.
 
 use std::time::Instant;
@@ -92,12 +92,15 @@ pub fn median(values: &[f64]) -> f64 {
     if v.len() % 2 == 1 { v[mid] } else { 0.5 * (v[mid - 1] + v[mid]) }
 }
 
-/// Each library's warm-up, then `reps` rounds in which every library traces `rays` once, timed,
-/// on `pool`: library `i`'s answers go to `answers[i]` (the last run's are left there), its
-/// timing is entry `i` of the result. The libraries take turns within each round, each starting
-/// one round in turn, so that the machine's other work, which comes and goes over seconds, falls
-/// on every library's runs alike rather than on the one whose runs it met: the ratios between
-/// libraries of one cell are what a run is for.
+/// `reps` rounds in which every library traces `rays` once untimed, then once timed, on `pool`:
+/// library `i`'s answers go to `answers[i]` (the last run's are left there), its timing is entry
+/// `i` of the result. The libraries take turns within each round, each starting one round in
+/// turn, so that the machine's other work, which comes and goes over seconds, falls on every
+/// library's runs alike rather than on the one whose runs it met: the ratios between libraries of
+/// one cell are what a run is for. The untimed run before each timed one brings the library's
+/// structure back into the caches the others' turns took it out of, as one library's runs one
+/// after another would find it (without it, the short runs of primary rays measured mostly cold
+/// caches: `docs/performance.md`).
 pub fn time_queries(
     pool: &rayon::ThreadPool,
     libraries: &[&dyn Library],
@@ -107,14 +110,12 @@ pub fn time_queries(
 ) -> Vec<Timing> {
     assert_eq!(libraries.len(), answers.len(), "one answer buffer per library");
     pool.install(|| {
-        for (library, out) in libraries.iter().zip(answers.iter_mut()) {
-            trace(*library, rays, out);
-        }
         let n = libraries.len();
         let mut runs = vec![Vec::with_capacity(reps); n];
         for round in 0..reps {
             for turn in 0..n {
                 let i = (round + turn) % n;
+                trace(libraries[i], rays, &mut answers[i]);
                 let start = Instant::now();
                 trace(libraries[i], rays, &mut answers[i]);
                 runs[i].push(start.elapsed().as_secs_f64());
@@ -227,8 +228,8 @@ mod tests {
         let pool = thread_pool(1).unwrap();
         let timings = time_queries(&pool, &dyn_libraries, &rays, &mut answers, 4);
         assert!(timings.iter().all(|t| t.runs.len() == 4));
-        // The warm-ups, then four rounds, each library first in one round in turn.
-        assert_eq!(*log.lock().unwrap(), [0, 1, 2, 0, 1, 2, 1, 2, 0, 2, 0, 1, 0, 1, 2]);
+        // Four rounds, each library first in one round in turn, each run after an untimed one.
+        assert_eq!(*log.lock().unwrap(), [0, 0, 1, 1, 2, 2, 1, 1, 2, 2, 0, 0, 2, 2, 0, 0, 1, 1, 0, 0, 1, 1, 2, 2]);
         for (id, answers) in answers.iter().enumerate() {
             let Answers::Closest(out) = answers else { panic!("closest answers") };
             assert!(out.iter().all(|r| r.prim == id as u32), "library {id}'s answers are its own");
