@@ -1,7 +1,6 @@
-//! Timing: a query set traced by each library on a pool of `n` threads, the rays split into chunks
-//! that the threads take in turn; `reps` rounds in which the libraries take turns, each with an
-//! untimed warm-up run and a timed one, and each library's median. Results are written into
-//! buffers allocated once, outside the timed runs.
+//! Timing: a query set traced by one library on a pool of `n` threads, the rays split into chunks
+//! that the threads take in turn; one untimed warm-up run, then `reps` timed runs, and their
+//! median. Results are written into buffers allocated once, outside the timed runs.
 
 use std::time::Instant;
 
@@ -92,36 +91,25 @@ pub fn median(values: &[f64]) -> f64 {
     if v.len() % 2 == 1 { v[mid] } else { 0.5 * (v[mid - 1] + v[mid]) }
 }
 
-/// `reps` rounds in which every library traces `rays` once untimed, then once timed, on `pool`:
-/// library `i`'s answers go to `answers[i]` (the last run's are left there), its timing is entry
-/// `i` of the result. The libraries take turns within each round, each starting one round in
-/// turn, so that the machine's other work, which comes and goes over seconds, falls on every
-/// library's runs alike rather than on the one whose runs it met: the ratios between libraries of
-/// one cell are what a run is for. The untimed run before each timed one brings the library's
-/// structure back into the caches the others' turns took it out of, as one library's runs one
-/// after another would find it (without it, the short runs of primary rays measured mostly cold
-/// caches: `docs/performance.md`).
-pub fn time_queries(
+/// Warm-up then `reps` timed runs of `query` over `rays` on `pool`; the answers of the last run
+/// are left in `answers`.
+pub fn time_query(
     pool: &rayon::ThreadPool,
-    libraries: &[&dyn Library],
+    library: &dyn Library,
     rays: &[BenchRay],
-    answers: &mut [Answers],
+    answers: &mut Answers,
     reps: usize,
-) -> Vec<Timing> {
-    assert_eq!(libraries.len(), answers.len(), "one answer buffer per library");
+) -> Timing {
     pool.install(|| {
-        let n = libraries.len();
-        let mut runs = vec![Vec::with_capacity(reps); n];
-        for round in 0..reps {
-            for turn in 0..n {
-                let i = (round + turn) % n;
-                trace(libraries[i], rays, &mut answers[i]);
+        trace(library, rays, answers);
+        let runs = (0..reps)
+            .map(|_| {
                 let start = Instant::now();
-                trace(libraries[i], rays, &mut answers[i]);
-                runs[i].push(start.elapsed().as_secs_f64());
-            }
-        }
-        runs.into_iter().map(|runs| Timing { runs }).collect()
+                trace(library, rays, answers);
+                start.elapsed().as_secs_f64()
+            })
+            .collect();
+        Timing { runs }
     })
 }
 
@@ -190,49 +178,6 @@ mod tests {
         // On Linux the process has some; elsewhere nothing is claimed.
         if cfg!(target_os = "linux") {
             assert!(resident_bytes().is_some_and(|b| b > 0));
-        }
-    }
-
-    /// A library that records, in a log shared by all, which one traced and when, and answers
-    /// every ray with its own number.
-    struct Logged {
-        id: u32,
-        log: std::sync::Arc<std::sync::Mutex<Vec<u32>>>,
-    }
-
-    impl Library for Logged {
-        fn structure(&self) -> String {
-            format!("logged {}", self.id)
-        }
-
-        fn closest_hits(&self, rays: &[BenchRay], out: &mut [RayResult]) {
-            self.log.lock().unwrap().push(self.id);
-            for (o, _) in out.iter_mut().zip(rays) {
-                *o = RayResult::hit(1.0, self.id);
-            }
-        }
-
-        fn any_hits(&self, _: &[BenchRay], out: &mut [bool]) {
-            out.fill(self.id % 2 == 1);
-        }
-    }
-
-    #[test]
-    fn libraries_take_turns_and_keep_their_own_answers() {
-        let log = std::sync::Arc::new(std::sync::Mutex::new(Vec::new()));
-        let libraries: Vec<Logged> = (0..3).map(|id| Logged { id, log: log.clone() }).collect();
-        let dyn_libraries: Vec<&dyn Library> = libraries.iter().map(|l| l as &dyn Library).collect();
-        // One chunk of rays, so that each trace is one call.
-        let rays = vec![BenchRay::new(englobe::Vec3::ZERO, englobe::Vec3::X); CHUNK];
-        let mut answers: Vec<Answers> = (0..3).map(|_| Answers::new(Query::Closest, rays.len())).collect();
-        let pool = thread_pool(1).unwrap();
-        let timings = time_queries(&pool, &dyn_libraries, &rays, &mut answers, 4);
-        assert!(timings.iter().all(|t| t.runs.len() == 4));
-        // Four rounds, each library first in one round in turn, each run after an untimed one.
-        assert_eq!(*log.lock().unwrap(), [0, 0, 1, 1, 2, 2, 1, 1, 2, 2, 0, 0, 2, 2, 0, 0, 1, 1, 0, 0, 1, 1, 2, 2]);
-        for (id, answers) in answers.iter().enumerate() {
-            let Answers::Closest(out) = answers else { panic!("closest answers") };
-            assert!(out.iter().all(|r| r.prim == id as u32), "library {id}'s answers are its own");
         }
     }
 

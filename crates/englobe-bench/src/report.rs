@@ -70,13 +70,8 @@ pub fn table(group: &[Measurement], cells: &[Cell]) -> String {
         let _ = write!(s, "{:>18}", c.name());
     }
     let _ = writeln!(s, "  agreement");
-    // In the order they first appear (the measurements come cell by cell, each library in turn).
-    let mut libraries: Vec<LibraryKind> = Vec::new();
-    for m in group {
-        if !libraries.contains(&m.library) {
-            libraries.push(m.library);
-        }
-    }
+    let mut libraries: Vec<LibraryKind> = group.iter().map(|m| m.library).collect();
+    libraries.dedup();
     for lib in libraries {
         let rows: Vec<&Measurement> = group.iter().filter(|m| m.library == lib).collect();
         let bytes = rows[0].build_bytes_per_triangle().map_or("-".to_owned(), |b| format!("{b:.0}"));
