@@ -94,15 +94,16 @@ import csv, pathlib, statistics, sys
 from collections import defaultdict
 
 runs, aligns = pathlib.Path(sys.argv[1]), sys.argv[2:]
-rates = defaultdict(list)  # (cell, side, align) -> rays per second of each round
 by_round = {}  # (cell, side, align, round) -> rays per second
 for path in sorted(runs.glob("*.csv")):
     side, align, round_ = path.stem.split("-")
     for row in csv.DictReader(path.open()):
         if row["rays"] != "build":
             cell = f'{row["scene"]} {row["rays"]} {row["query"]}'
-            rates[cell, side, align].append(float(row["mrays_per_s"]))
             by_round[cell, side, align, round_] = float(row["mrays_per_s"])
+rates = defaultdict(list)  # (cell, side, align) -> rays per second of each round
+for (cell, side, align, _), rate in by_round.items():
+    rates[cell, side, align].append(rate)
 cells = sorted({cell for cell, _, _ in rates})
 head = f'{"cell":32} {"A Mrays/s":>10} {"B Mrays/s":>10}' + "".join(f' {"B/A " + a:>11}' for a in aligns)
 print(head + f' {"median":>7} {"paired":>7} {"B won":>7}')
@@ -110,9 +111,9 @@ for cell in cells:
     every = {s: [r for a in aligns for r in rates[cell, s, a]] for s in "AB"}
     ratios = [statistics.median(rates[cell, "B", a]) / statistics.median(rates[cell, "A", a]) for a in aligns]
     pairs = [
-        b / by_round[cell, "A", a, r]
-        for (c, s, a, r), b in by_round.items()
-        if c == cell and s == "B" and (cell, "A", a, r) in by_round
+        rate / by_round[cell, "A", a, r]
+        for (c, s, a, r), rate in by_round.items()
+        if (c, s) == (cell, "B") and (cell, "A", a, r) in by_round
     ]
     line = f"{cell:32} {statistics.median(every['A']):10.3f} {statistics.median(every['B']):10.3f}"
     won = f"{sum(p > 1 for p in pairs)}/{len(pairs)}"
