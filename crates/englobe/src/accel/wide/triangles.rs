@@ -88,16 +88,17 @@ pub fn is_storable(v: &[Vec3; 3]) -> bool {
 pub struct TriRay {
     /// The origin's coordinates along `kx, ky, kz`.
     origin: [Vec4; 3],
-    /// The inverse direction's components along `kx, ky, kz`.
-    inv_dir: [Vec4; 3],
+    /// The inverse direction's components along `kx` and `ky` (along `kz` the box correction
+    /// uses the shear's, the same number: see [`intersect_block`]).
+    inv_dir: [Vec4; 2],
     /// The axes `kx, ky, kz`: each below 3 (an invariant of [`TriRay::new`], which
     /// [`TriRay::row`] relies on to read a block without a bounds check).
     axes: [usize; 3],
     shear: [Vec4; 3],
-    /// The lanes of axis `kx, ky, kz` where the ray goes down it (`inv_dir < 0`, all of them or
+    /// The lanes of axis `kx`, `ky` where the ray goes down it (`inv_dir < 0`, all of them or
     /// none): where the box correction's near and far planes are a triangle's largest and
     /// smallest coordinates.
-    down: [BVec4A; 3],
+    down: [BVec4A; 2],
     t_min: Vec4,
 }
 
@@ -113,10 +114,10 @@ impl TriRay {
         let axes = watertight.axes();
         TriRay {
             origin: axes.map(|a| Vec4::splat(o[a])),
-            inv_dir: axes.map(|a| Vec4::splat(inv[a])),
+            inv_dir: [0, 1].map(|k| Vec4::splat(inv[axes[k]])),
             axes,
             shear: [0, 1, 2].map(|a| Vec4::splat(s[a])),
-            down: axes.map(|a| Vec4::splat(inv[a]).cmplt(Vec4::ZERO)),
+            down: [0, 1].map(|k| Vec4::splat(inv[axes[k]]).cmplt(Vec4::ZERO)),
             t_min: Vec4::splat(ray.t_min),
         }
     }
@@ -147,7 +148,8 @@ impl TriRay {
         );
         // `(d[kx], d[ky], 1) / d[kz]`: `WatertightRay::new`'s three quotients.
         let shear = _mm_div_ps(_mm_blend_ps::<0b0100>(d, _mm_set1_ps(1.0)), _mm_permute_ps::<0b10_10_10_10>(d));
-        let inv_dir = lanes(inv);
+        let [inv_x, inv_y, _] = lanes(inv);
+        let inv_dir = [inv_x, inv_y];
         TriRay {
             origin: lanes(o),
             inv_dir,
@@ -339,12 +341,27 @@ pub fn intersect_block(block: &TriBlock, r: &TriRay, t_max: f32) -> Option<Block
     let candidate = candidate & finite;
 
     // The box-stretch correction of the scalar test's `finish`: the stretch of the whole line
-    // inside the triangle's box, computed as the robust slab test computes it. The axes are taken
-    // in the order `kx, ky, kz` rather than `x, y, z`: the largest entry and the smallest exit do not
-    // depend on the order (a NaN distance is skipped wherever it comes; only the sign of a zero
-    // could differ, and it compares equal), and the rows are the ones the projection read.
-    let (mut enter, mut exit) = (Vec4::NEG_INFINITY, Vec4::INFINITY);
-    for axis in 0..3 {
+    // inside the triangle's box, computed as the robust slab test computes it. Along the ray's
+    // main axis `kz` the vertices' slab distances are `az`, `bz` and `cz` themselves: a plane's
+    // distance there is `(v - o) * inv_dir[kz]`, the same product (`shear.z` is `1 / d[kz]`, the
+    // inverse direction's lane bit for bit, `d[kz]` never being zero), and rounding is monotonic,
+    // so the nearest and farthest of the three are the distances of the box's near and far planes.
+    // They are finite in every candidate lane (an infinite or NaN one would have made `t` so).
+    let near_z = az.min(bz).min(cz);
+    let far_z = az.max(bz).max(cz) * ROBUST_FAR_SCALE;
+    // The corrected `t` lies between them, so a lane whose stretch along `kz` ends before the
+    // interval or begins after it is a miss, known before the other two axes are computed: the
+    // blocks behind the closest hit so far, or behind the ray's origin, stop here.
+    let reachable = candidate & near_z.cmple(Vec4::splat(t_max)) & far_z.cmpge(r.t_min);
+    if !reachable.any() {
+        return Some(BlockHits { special: special.bitmask(), ..BlockHits::NONE });
+    }
+    // The other two axes, `kx` and `ky`. The axes are taken in the order `kz, kx, ky` rather than
+    // `x, y, z`: the largest entry and the smallest exit do not depend on the order (a NaN
+    // distance is skipped wherever it comes; only the sign of a zero could differ, and it compares
+    // equal), and the rows are the ones the projection read.
+    let (mut enter, mut exit) = (near_z, far_z);
+    for axis in 0..2 {
         let (p, q, s) = (r.row(block, 0, axis), r.row(block, 1, axis), r.row(block, 2, axis));
         let (lo, hi) = (p.min(q).min(s), p.max(q).max(s));
         let inv = r.inv_dir[axis];
@@ -359,7 +376,7 @@ pub fn intersect_block(block: &TriBlock, r: &TriRay, t_max: f32) -> Option<Block
     let t = keep_greater(enter, t);
     let t = keep_less(exit, t);
     let in_range = t.cmpge(r.t_min) & t.cmple(Vec4::splat(t_max));
-    let hit = candidate & in_box & in_range;
+    let hit = reachable & in_box & in_range;
     Some(BlockHits { hit: hit.bitmask(), special: special.bitmask(), t, u: e1 * inv_det, v: e2 * inv_det })
 }
 
@@ -521,6 +538,32 @@ mod tests {
             compared += 1;
         }
         assert!(compared > 20_000, "{compared}");
+    }
+
+    #[test]
+    fn the_shear_along_the_main_axis_is_the_inverse_direction() {
+        // What lets the box correction take its distances along `kz` from the projection: the
+        // shear's `1 / d[kz]` and the ray's inverse direction there are one number, for ordinary
+        // directions and for components at the ends of the range.
+        let mut next = rng(0x1d1f_2e3a);
+        let values = [-3e38, -1.0, -1e-30, -1e-38, 0.0, 1e-45, 1e-38, 0.5, 7.0, 3e38];
+        let mut dirs: Vec<Vec3> = (0..10_000).map(|_| point(&mut next)).collect();
+        for x in values {
+            for y in values {
+                for z in values {
+                    dirs.push(Vec3::new(x, y, z));
+                }
+            }
+        }
+        for d in dirs {
+            let ray = Ray::new(Vec3::ZERO, d);
+            if !ray.is_valid() {
+                continue;
+            }
+            let w = WatertightRay::new(&ray);
+            let kz = w.axes()[2];
+            assert_eq!(w.shear().z.to_bits(), ray.inv_dir()[kz].to_bits(), "{d:?}");
+        }
     }
 
     #[test]
