@@ -185,11 +185,24 @@ pub(super) fn take_lowest(mask: &mut u32) -> usize {
     slot
 }
 
+/// `if first_wanted { first } else { second }`, field by field, without a branch (a whole entry
+/// selected at once goes through memory).
+#[inline(always)]
+fn pick(first_wanted: bool, first: Entry, second: Entry) -> Entry {
+    use std::hint::select_unpredictable as select;
+    Entry {
+        reference: select(first_wanted, first.reference, second.reference),
+        count: select(first_wanted, first.count, second.count),
+        t: select(first_wanted, first.t, second.t),
+    }
+}
+
 /// The two entries with the farther one first, as they go on the stack; a tie keeps them in
 /// their order (only a strictly nearer second entry is swapped), as an insertion sort does.
 #[inline(always)]
 fn farther_first(first: Entry, second: Entry) -> (Entry, Entry) {
-    if first.t < second.t { (second, first) } else { (first, second) }
+    let swap = first.t < second.t;
+    (pick(swap, second, first), pick(swap, first, second))
 }
 
 /// The closest hit: walks the tree from node `start` (0, the root, for a whole query), asking
@@ -247,7 +260,10 @@ pub unsafe fn closest<K: NodeKernel, C: Counters, L: Leaves<C>>(
                     let second = take_lowest(&mut mask);
                     let b = asked_entry(nodes, node, second, &dist, leaves);
                     if mask == 0 {
-                        let (near, far) = if b.t < a.t { (b, a) } else { (a, b) };
+                        // Which of two children is nearer is a coin toss for incoherent rays:
+                        // chosen by selection rather than by a branch that the predictor loses.
+                        let b_nearer = b.t < a.t;
+                        let (near, far) = (pick(b_nearer, b, a), pick(b_nearer, a, b));
                         stack[len].write(far);
                         len += 1;
                         current = near;
