@@ -260,10 +260,7 @@ pub unsafe fn closest<K: NodeKernel, C: Counters, L: Leaves<C>>(
                     let second = take_lowest(&mut mask);
                     let b = asked_entry(nodes, node, second, &dist, leaves);
                     if mask == 0 {
-                        // Which of two children is nearer is a coin toss for incoherent rays:
-                        // chosen by selection rather than by a branch that the predictor loses.
-                        let b_nearer = b.t < a.t;
-                        let (near, far) = (pick(b_nearer, b, a), pick(b_nearer, a, b));
+                        let (near, far) = if b.t < a.t { (b, a) } else { (a, b) };
                         stack[len].write(far);
                         len += 1;
                         current = near;
