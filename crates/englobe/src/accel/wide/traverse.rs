@@ -403,7 +403,10 @@ pub unsafe fn any<K: NodeKernel, C: Counters, L: Leaves<C>>(
                     while mask != 0 {
                         let i = take_lowest(&mut mask);
                         prefetch_child(nodes, node.children[i], |first| leaves.prefetch(first));
-                        let push = if dist[i] > dist[farthest] { std::mem::replace(&mut farthest, i) } else { i };
+                        // Selected, not branched on: which child reaches farther is a coin toss.
+                        let further = dist[i] > dist[farthest];
+                        let push = std::hint::select_unpredictable(further, farthest, i);
+                        farthest = std::hint::select_unpredictable(further, i, farthest);
                         stack[len].write(Entry {
                             reference: node.children[push],
                             count: node.counts[push] as u32,
