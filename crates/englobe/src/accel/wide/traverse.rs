@@ -4,7 +4,10 @@
 //! of Wald, Benthin and Boulos (2008), "Getting Rid of Packets: Efficient SIMD Single-Ray
 //! Traversal using Multi-branching BVHs", in the form Embree's `BVHNIntersector1` gives it (Wald
 //! et al. 2014): no sorting at all when one child or two are hit (the common cases), up to five
-//! sorted in registers by compare-and-swap, an insertion sort on the stack for the rest.
+//! sorted in registers by compare-and-swap, an insertion sort on the stack for the rest. The swaps
+//! are selections, not branches: the order of three children or more is a coin toss for incoherent
+//! rays, which a branch predictor loses; two are ordered by a branch, which the coherent rays of a
+//! camera predict well (selecting there too cost primary rays 2-4 %, see `docs/performance.md`).
 //!
 //! Occlusion queries stop at the first occluder and do not sort: they enter the *farthest* child
 //! hit first and push the others as they come. A ray's far boxes are where the surfaces that close
@@ -17,7 +20,8 @@
 //! is by where the ray leaves a box ([`NodeKernel::children_exits`]), not where it enters: a box
 //! the ray crosses for longer, out to a farther wall, is likelier to hold what stops it than one
 //! it enters late and leaves at once (another 2-7 % fewer nodes on random rays, up to 2.4 % on
-//! the renderer's shadow rays).
+//! the renderer's shadow rays). The farthest is kept by selection, not by a branch, for the
+//! reason the closest-hit walk's sort gives.
 //!
 //! The traversal is generic over the node test ([`NodeKernel`], one per instruction set) and over
 //! what leaves hold ([`Leaves`]: primitive references tested by a closure, or blocks of
