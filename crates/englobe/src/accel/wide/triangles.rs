@@ -349,13 +349,6 @@ pub fn intersect_block(block: &TriBlock, r: &TriRay, t_max: f32) -> Option<Block
     // They are finite in every candidate lane (an infinite or NaN one would have made `t` so).
     let near_z = az.min(bz).min(cz);
     let far_z = az.max(bz).max(cz) * ROBUST_FAR_SCALE;
-    // The corrected `t` lies between them, so a lane whose stretch along `kz` ends before the
-    // interval or begins after it is a miss, known before the other two axes are computed: the
-    // blocks behind the closest hit so far, or behind the ray's origin, stop here.
-    let reachable = candidate & near_z.cmple(Vec4::splat(t_max)) & far_z.cmpge(r.t_min);
-    if !reachable.any() {
-        return Some(BlockHits { special: special.bitmask(), ..BlockHits::NONE });
-    }
     // The other two axes, `kx` and `ky`. The axes are taken in the order `kz, kx, ky` rather than
     // `x, y, z`: the largest entry and the smallest exit do not depend on the order (a NaN
     // distance is skipped wherever it comes; only the sign of a zero could differ, and it compares
@@ -376,7 +369,7 @@ pub fn intersect_block(block: &TriBlock, r: &TriRay, t_max: f32) -> Option<Block
     let t = keep_greater(enter, t);
     let t = keep_less(exit, t);
     let in_range = t.cmpge(r.t_min) & t.cmple(Vec4::splat(t_max));
-    let hit = reachable & in_box & in_range;
+    let hit = candidate & in_box & in_range;
     Some(BlockHits { hit: hit.bitmask(), special: special.bitmask(), t, u: e1 * inv_det, v: e2 * inv_det })
 }
 
