@@ -112,12 +112,13 @@ impl TriRay {
         let (o, inv, s) =
             (ray.origin_a().extend(0.0).to_array(), ray.inv_dir_a().extend(0.0).to_array(), watertight.shear());
         let axes = watertight.axes();
+        let inv_dir = [0, 1].map(|k| Vec4::splat(inv[axes[k]]));
         TriRay {
             origin: axes.map(|a| Vec4::splat(o[a])),
-            inv_dir: [0, 1].map(|k| Vec4::splat(inv[axes[k]])),
+            inv_dir,
             axes,
             shear: [0, 1, 2].map(|a| Vec4::splat(s[a])),
-            down: [0, 1].map(|k| Vec4::splat(inv[axes[k]]).cmplt(Vec4::ZERO)),
+            down: inv_dir.map(|inv| inv.cmplt(Vec4::ZERO)),
             t_min: Vec4::splat(ray.t_min),
         }
     }
@@ -548,6 +549,7 @@ mod tests {
                 }
             }
         }
+        let mut compared = 0;
         for d in dirs {
             let ray = Ray::new(Vec3::ZERO, d);
             if !ray.is_valid() {
@@ -556,7 +558,9 @@ mod tests {
             let w = WatertightRay::new(&ray);
             let kz = w.axes()[2];
             assert_eq!(w.shear().z.to_bits(), ray.inv_dir()[kz].to_bits(), "{d:?}");
+            compared += 1;
         }
+        assert!(compared > 10_000, "{compared}");
     }
 
     #[test]
