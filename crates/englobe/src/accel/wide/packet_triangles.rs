@@ -12,6 +12,8 @@
 //! So every ray keeps the answer of its own query.
 
 use super::packet_kernels::{Lanes, PACKET, PacketRays};
+#[cfg(target_arch = "x86_64")]
+use super::triangles::TriBlock;
 use crate::Vec3;
 use crate::accel::Hit;
 use crate::shapes::WatertightRay;
@@ -133,8 +135,69 @@ impl PacketBest {
     }
 }
 
+/// The whole-packet test of one block, compiled for one instruction set ([`Avx512Block`] or
+/// [`Avx2Block`]): what a packet walk compiled for that set tests its leaves with.
 #[cfg(target_arch = "x86_64")]
-pub use x86::block_avx512;
+pub trait BlockTest: Copy {
+    /// Tests the rays of `rays` against every used triangle of `block`, as
+    /// [`block_avx512`] does.
+    ///
+    /// # Safety
+    /// The processor has the test's instruction set, and the caller should be compiled with it.
+    unsafe fn block(
+        block: &TriBlock,
+        packet: &PacketRays,
+        r: &PacketTriRays,
+        rays: u32,
+        best: &mut PacketBest,
+        closest: bool,
+    ) -> (u32, u64);
+}
+
+/// The test with AVX-512: the sixteen rays in one vector.
+#[cfg(target_arch = "x86_64")]
+#[derive(Clone, Copy, Debug)]
+pub struct Avx512Block;
+
+/// The test with AVX2: the sixteen rays in two vectors of eight.
+#[cfg(target_arch = "x86_64")]
+#[derive(Clone, Copy, Debug)]
+pub struct Avx2Block;
+
+#[cfg(target_arch = "x86_64")]
+impl BlockTest for Avx512Block {
+    #[inline(always)]
+    unsafe fn block(
+        block: &TriBlock,
+        packet: &PacketRays,
+        r: &PacketTriRays,
+        rays: u32,
+        best: &mut PacketBest,
+        closest: bool,
+    ) -> (u32, u64) {
+        // SAFETY: the caller's guarantee: AVX-512.
+        unsafe { block_avx512(block, packet, r, rays, best, closest) }
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+impl BlockTest for Avx2Block {
+    #[inline(always)]
+    unsafe fn block(
+        block: &TriBlock,
+        packet: &PacketRays,
+        r: &PacketTriRays,
+        rays: u32,
+        best: &mut PacketBest,
+        closest: bool,
+    ) -> (u32, u64) {
+        // SAFETY: the caller's guarantee: AVX2.
+        unsafe { block_avx2(block, packet, r, rays, best, closest) }
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+pub use x86::{block_avx2, block_avx512};
 
 #[cfg(target_arch = "x86_64")]
 mod x86 {
@@ -270,6 +333,160 @@ mod x86 {
                 special_pairs |= (special as u64) << (16 * lane);
             }
             (hit_rays as u32, special_pairs)
+        }
+    }
+
+    /// [`block_avx512`] with AVX2: the packet's sixteen lanes as two vectors of eight, each
+    /// computing what the AVX-512 test computes in those lanes (the same operations in the same
+    /// order; a mask register's blend is a blend by a comparison's lanes here).
+    ///
+    /// # Safety
+    /// The processor has AVX2. The caller should be compiled with it, or every intrinsic below
+    /// becomes a call.
+    #[inline(always)]
+    pub unsafe fn block_avx2(
+        block: &TriBlock,
+        packet: &PacketRays,
+        r: &PacketTriRays,
+        rays: u32,
+        best: &mut PacketBest,
+        closest: bool,
+    ) -> (u32, u64) {
+        /// Lanes of one vector.
+        const HALF: usize = 8;
+        // SAFETY: the caller's guarantee: the processor has the features of every intrinsic.
+        unsafe {
+            let [kx, ky, kz] = r.axes;
+            let zero = _mm256_setzero_ps();
+            let abs = |x: __m256| _mm256_andnot_ps(_mm256_set1_ps(-0.0), x);
+            let bits = |m: __m256| _mm256_movemask_ps(m) as u32;
+            let lt = |a: __m256, b: __m256| _mm256_cmp_ps::<_CMP_LT_OQ>(a, b);
+            let gt = |a: __m256, b: __m256| _mm256_cmp_ps::<_CMP_GT_OQ>(a, b);
+            let normal = |x: __m256| {
+                _mm256_and_ps(
+                    _mm256_cmp_ps::<_CMP_GE_OQ>(abs(x), _mm256_set1_ps(f32::MIN_POSITIVE)),
+                    lt(abs(x), _mm256_set1_ps(f32::INFINITY)),
+                )
+            };
+            // The lanes of `lanes` (eight bits) as a comparison's lanes.
+            let lanes_of = |lanes: u32| {
+                let bit = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
+                let set = _mm256_and_si256(_mm256_set1_epi32(lanes as i32), bit);
+                _mm256_castsi256_ps(_mm256_cmpeq_epi32(set, bit))
+            };
+            let (mut hit_rays, mut special_pairs) = (0u32, 0u64);
+            for h in 0..2 {
+                let rays_h = (rays >> (HALF * h)) & 0xff;
+                if rays_h == 0 {
+                    continue;
+                }
+                // Aligned loads and stores: each half of a `Lanes` is 32 bytes at an offset of 0
+                // or 32 from a 64-aligned start.
+                let load = |l: &super::Lanes| _mm256_load_ps(l.0.as_ptr().add(HALF * h));
+                let o_k = [load(&r.origin_k[0]), load(&r.origin_k[1]), load(&r.origin_k[2])];
+                let (sx, sy, sz) = (load(&r.shear[0]), load(&r.shear[1]), load(&r.shear[2]));
+                for lane in 0..LANES {
+                    let id = block.ids[lane];
+                    if id == UNUSED {
+                        continue;
+                    }
+                    let at = |k: usize, axis: usize| block.v[3 * k + axis][lane];
+                    // As in `block_avx512`.
+                    macro_rules! project {
+                        ($k:expr) => {{
+                            let x = _mm256_sub_ps(_mm256_set1_ps(at($k, kx)), o_k[0]);
+                            let y = _mm256_sub_ps(_mm256_set1_ps(at($k, ky)), o_k[1]);
+                            let z = _mm256_sub_ps(_mm256_set1_ps(at($k, kz)), o_k[2]);
+                            (_mm256_sub_ps(x, _mm256_mul_ps(sx, z)), _mm256_sub_ps(y, _mm256_mul_ps(sy, z)), z)
+                        }};
+                    }
+                    let (ax, ay, a_z) = project!(0);
+                    let (bx, by, b_z) = project!(1);
+                    let (cx, cy, c_z) = project!(2);
+                    let e0 = _mm256_sub_ps(_mm256_mul_ps(cx, by), _mm256_mul_ps(cy, bx));
+                    let e1 = _mm256_sub_ps(_mm256_mul_ps(ax, cy), _mm256_mul_ps(ay, cx));
+                    let e2 = _mm256_sub_ps(_mm256_mul_ps(bx, ay), _mm256_mul_ps(by, ax));
+                    let negative = bits(_mm256_or_ps(_mm256_or_ps(lt(e0, zero), lt(e1, zero)), lt(e2, zero)));
+                    let positive = bits(_mm256_or_ps(_mm256_or_ps(gt(e0, zero), gt(e1, zero)), gt(e2, zero)));
+                    let inside = !(negative & positive) & rays_h;
+                    if inside == 0 {
+                        continue;
+                    }
+                    let all_normal = bits(_mm256_and_ps(_mm256_and_ps(normal(e0), normal(e1)), normal(e2)));
+                    let mut special = inside & !all_normal;
+                    let candidate = inside & all_normal;
+                    if candidate != 0 {
+                        let (az, bz, cz) = (_mm256_mul_ps(sz, a_z), _mm256_mul_ps(sz, b_z), _mm256_mul_ps(sz, c_z));
+                        let det = _mm256_add_ps(_mm256_add_ps(e0, e1), e2);
+                        let t_scaled = _mm256_add_ps(
+                            _mm256_add_ps(_mm256_mul_ps(e0, az), _mm256_mul_ps(e1, bz)),
+                            _mm256_mul_ps(e2, cz),
+                        );
+                        let inv_det = _mm256_div_ps(_mm256_set1_ps(1.0), det);
+                        let t = _mm256_mul_ps(t_scaled, inv_det);
+                        let finite = bits(lt(abs(t), _mm256_set1_ps(f32::INFINITY)));
+                        special |= candidate & !finite;
+                        let candidate = candidate & finite;
+                        // The box-stretch correction, as the block test computes it.
+                        let (mut enter, mut exit) = (_mm256_set1_ps(f32::NEG_INFINITY), _mm256_set1_ps(f32::INFINITY));
+                        for axis in 0..3 {
+                            let (p, q, s) = (at(0, axis), at(1, axis), at(2, axis));
+                            let (lo, hi) = (_mm256_set1_ps(p.min(q).min(s)), _mm256_set1_ps(p.max(q).max(s)));
+                            let inv = load(&packet.inv_dir[axis]);
+                            let o = load(&packet.origin[axis]);
+                            let positive_dir = _mm256_cmp_ps::<_CMP_GE_OQ>(inv, zero);
+                            let near = _mm256_blendv_ps(hi, lo, positive_dir);
+                            let far = _mm256_blendv_ps(lo, hi, positive_dir);
+                            let t_near = _mm256_mul_ps(_mm256_sub_ps(near, o), inv);
+                            let t_far = _mm256_mul_ps(
+                                _mm256_mul_ps(_mm256_sub_ps(far, o), inv),
+                                _mm256_set1_ps(ROBUST_FAR_SCALE),
+                            );
+                            // `max(a, b)` is `a > b ? a : b`: the block test's `keep_greater`.
+                            enter = _mm256_max_ps(t_near, enter);
+                            exit = _mm256_min_ps(t_far, exit);
+                        }
+                        let in_box = bits(_mm256_cmp_ps::<_CMP_LE_OQ>(enter, exit));
+                        let t = _mm256_blendv_ps(t, enter, lt(t, enter));
+                        let t = _mm256_blendv_ps(t, exit, gt(t, exit));
+                        let best_t = load(&best.t);
+                        let in_range = bits(_mm256_and_ps(
+                            _mm256_cmp_ps::<_CMP_GE_OQ>(t, load(&packet.t_min)),
+                            _mm256_cmp_ps::<_CMP_LE_OQ>(t, best_t),
+                        ));
+                        let hit = candidate & in_box & in_range;
+                        hit_rays |= hit << (HALF * h);
+                        if closest && hit != 0 {
+                            let prim = _mm256_set1_epi32(id as i32);
+                            let best_prim = _mm256_castps_si256(load(&best.prim));
+                            // `prim < best_prim` as unsigned numbers: both flipped at the top
+                            // bit, then compared as signed ones.
+                            let top = _mm256_set1_epi32(i32::MIN);
+                            let lower = _mm256_castsi256_ps(_mm256_cmpgt_epi32(
+                                _mm256_xor_si256(best_prim, top),
+                                _mm256_xor_si256(prim, top),
+                            ));
+                            let better = _mm256_and_ps(
+                                lanes_of(hit),
+                                _mm256_or_ps(
+                                    lt(t, best_t),
+                                    _mm256_and_ps(_mm256_cmp_ps::<_CMP_EQ_OQ>(t, best_t), lower),
+                                ),
+                            );
+                            let store = |l: &mut super::Lanes, x: __m256| {
+                                let at = l.0.as_mut_ptr().add(HALF * h);
+                                _mm256_store_ps(at, _mm256_blendv_ps(_mm256_load_ps(at), x, better))
+                            };
+                            store(&mut best.t, t);
+                            store(&mut best.u, _mm256_mul_ps(e1, inv_det));
+                            store(&mut best.v, _mm256_mul_ps(e2, inv_det));
+                            store(&mut best.prim, _mm256_castsi256_ps(prim));
+                        }
+                    }
+                    special_pairs |= (special as u64) << (16 * lane + HALF * h);
+                }
+            }
+            (hit_rays, special_pairs)
         }
     }
 }

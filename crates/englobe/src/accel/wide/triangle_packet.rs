@@ -14,6 +14,8 @@ use super::isa::Isa;
 use super::packet;
 use super::packet_kernels::{PACKET, PacketRays};
 use super::packet_triangles::PacketBest;
+#[cfg(target_arch = "x86_64")]
+use super::packet_triangles::{Avx2Block, Avx512Block};
 use super::ray_packet::{PacketHits, RayPacket};
 use super::triangle_bvh::TriangleBvh;
 #[cfg(target_arch = "x86_64")]
@@ -147,12 +149,21 @@ impl TriangleBvh {
         }
         packet.bound(active);
         #[cfg(target_arch = "x86_64")]
-        if self.isa() == Isa::Avx512 {
-            let mut leaves = TrianglePacket::new(self, packet, limits, WholePacket::new(active));
-            // SAFETY: the structure's instruction set is one the processor has (see `Isa`).
-            unsafe { dispatch::closest_packet_avx512(self.nodes(), packet, active, &mut leaves, counters) };
-            leaves.settle_closest(counters);
-            return leaves.best;
+        match self.isa() {
+            Isa::Avx512 => {
+                let mut leaves = TrianglePacket::new(self, packet, limits, WholePacket::<Avx512Block>::new(active));
+                // SAFETY: the structure's instruction set is one the processor has (see `Isa`).
+                unsafe { dispatch::closest_packet_avx512(self.nodes(), packet, active, &mut leaves, counters) };
+                leaves.settle_closest(counters);
+                return leaves.best;
+            }
+            Isa::Avx2 => {
+                let mut leaves = TrianglePacket::new(self, packet, limits, WholePacket::<Avx2Block>::new(active));
+                dispatch::closest_packet(Isa::Avx2, self.nodes(), packet, active, &mut leaves, counters);
+                leaves.settle_closest(counters);
+                return leaves.best;
+            }
+            Isa::Portable => {}
         }
         let mut leaves = TrianglePacket::new(self, packet, limits, RayByRay);
         dispatch::closest_packet(self.isa(), self.nodes(), packet, active, &mut leaves, counters);
@@ -235,11 +246,19 @@ impl TriangleBvh {
         }
         packet.bound(active);
         #[cfg(target_arch = "x86_64")]
-        if self.isa() == Isa::Avx512 {
-            let mut leaves = TrianglePacket::new(self, packet, limits, WholePacket::new(active));
-            // SAFETY: the structure's instruction set is one the processor has (see `Isa`).
-            let found = unsafe { dispatch::any_packet_avx512(self.nodes(), packet, active, &mut leaves, counters) };
-            return leaves.settle_any(found, counters);
+        match self.isa() {
+            Isa::Avx512 => {
+                let mut leaves = TrianglePacket::new(self, packet, limits, WholePacket::<Avx512Block>::new(active));
+                // SAFETY: the structure's instruction set is one the processor has (see `Isa`).
+                let found = unsafe { dispatch::any_packet_avx512(self.nodes(), packet, active, &mut leaves, counters) };
+                return leaves.settle_any(found, counters);
+            }
+            Isa::Avx2 => {
+                let mut leaves = TrianglePacket::new(self, packet, limits, WholePacket::<Avx2Block>::new(active));
+                let found = dispatch::any_packet(Isa::Avx2, self.nodes(), packet, active, &mut leaves, counters);
+                return leaves.settle_any(found, counters);
+            }
+            Isa::Portable => {}
         }
         let mut leaves = TrianglePacket::new(self, packet, limits, RayByRay);
         dispatch::any_packet(self.isa(), self.nodes(), packet, active, &mut leaves, counters)

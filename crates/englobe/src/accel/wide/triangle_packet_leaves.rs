@@ -1,6 +1,7 @@
-//! A packet's leaf tests in a [`TriangleBvh`]: with AVX-512, each triangle against the whole
-//! packet at once ([`WholePacket`], see [`super::packet_triangles`]); otherwise each ray against
-//! the blocks alone ([`RayByRay`], the single-ray leaf test of [`super::triangle_leaves`]).
+//! A packet's leaf tests in a [`TriangleBvh`]: with AVX-512 or AVX2, each triangle against the
+//! whole packet at once ([`WholePacket`], see [`super::packet_triangles`]); otherwise (the
+//! portable walk) each ray against the blocks alone ([`RayByRay`], the single-ray leaf test of
+//! [`super::triangle_leaves`]).
 //!
 //! The whole-packet walk has no call in its loop. x86-64 gives every vector register to the
 //! caller to save, so a call anywhere in the loop, even one never made, has the compiler keep the
@@ -25,12 +26,16 @@ use super::kernels::Portable;
 use super::node::{NodeRay, reach};
 use super::packet::PacketLeaves;
 use super::packet_kernels::{Lanes, PACKET, PacketRays};
+#[cfg(target_arch = "x86_64")]
+use super::packet_triangles::BlockTest;
 use super::packet_triangles::{PacketBest, PacketTriRays};
 use super::traverse::{Leaves, take_lowest};
 use super::triangle_bvh::TriangleBvh;
 use super::triangle_leaves;
 use crate::accel::{Counters, Hit, NoFilter};
 use crate::geom::prefetch::prefetch;
+#[cfg(target_arch = "x86_64")]
+use std::marker::PhantomData;
 
 /// The undecided pairs a packet notes in its walk.
 const DEFERRED: usize = 16;
@@ -47,10 +52,10 @@ pub(super) struct TrianglePacket<'a, T> {
     test: T,
 }
 
-/// Each triangle tested against the whole packet (AVX-512), with the pairs the test leaves
-/// undecided.
+/// Each triangle tested against the whole packet (with the block test `B`: AVX-512's or AVX2's),
+/// with the pairs the test leaves undecided.
 #[cfg(target_arch = "x86_64")]
-pub(super) struct WholePacket {
+pub(super) struct WholePacket<B> {
     /// The rays walked.
     active: u32,
     /// Their triangle constants, prepared at the first leaf: a packet that reaches none (as most
@@ -63,6 +68,7 @@ pub(super) struct WholePacket {
     /// The rays asked again alone when the walk has ended: those that met more undecided pairs
     /// than `noted` holds, or all of them if they do not share the test's axes.
     again: u32,
+    test: PhantomData<B>,
 }
 
 /// Each ray tested against the blocks alone, with the single-ray leaf test.
@@ -107,21 +113,22 @@ impl<'a, T> TrianglePacket<'a, T> {
 }
 
 #[cfg(target_arch = "x86_64")]
-impl WholePacket {
+impl<B: BlockTest> WholePacket<B> {
     /// The whole-packet test of the rays of `active`.
     pub(super) fn new(active: u32) -> Self {
-        WholePacket { active, tri: None, noted: [(0, 0); DEFERRED], len: 0, again: 0 }
+        WholePacket { active, tri: None, noted: [(0, 0); DEFERRED], len: 0, again: 0, test: PhantomData }
     }
 }
 
 #[cfg(target_arch = "x86_64")]
-impl TrianglePacket<'_, WholePacket> {
+impl<B: BlockTest> TrianglePacket<'_, WholePacket<B>> {
     /// Tests the blocks from `first` against the rays of `rays` a whole packet at a time; returns
     /// the rays that hit one (with `closest`, their closest hits are kept). Notes the pairs left
     /// undecided.
     ///
     /// # Safety
-    /// The processor has AVX-512 (the test is compiled into the caller, which should enable it).
+    /// The processor has `B`'s instruction set (the test is compiled into the caller, which
+    /// should enable it).
     #[inline(always)]
     unsafe fn test_blocks<C: Counters>(
         &mut self,
@@ -131,7 +138,6 @@ impl TrianglePacket<'_, WholePacket> {
         closest: bool,
         counters: &mut C,
     ) -> u32 {
-        use super::packet_triangles::block_avx512;
         if self.test.tri.is_none() {
             match PacketTriRays::shared_axes(self.packet, self.test.active) {
                 Some(axes) => self.test.tri = Some(PacketTriRays::new(self.packet, self.test.active, axes)),
@@ -152,7 +158,7 @@ impl TrianglePacket<'_, WholePacket> {
             // Any hit: the rays that found an occluder are done.
             let pending = if closest { rays } else { rays & !found };
             // SAFETY: the caller's guarantee.
-            let (hit, mut special) = unsafe { block_avx512(block, packet, tri, pending, best, closest) };
+            let (hit, mut special) = unsafe { B::block(block, packet, tri, pending, best, closest) };
             found |= hit;
             while special != 0 {
                 let bit = special.trailing_zeros();
@@ -274,7 +280,7 @@ impl<C: Counters, T: LeafTest> PacketLeaves<C> for TrianglePacket<'_, T> {
 }
 
 #[cfg(target_arch = "x86_64")]
-impl LeafTest for WholePacket {
+impl<B: BlockTest> LeafTest for WholePacket<B> {
     #[inline(always)]
     fn closest<C: Counters>(
         leaves: &mut TrianglePacket<'_, Self>,
@@ -283,7 +289,7 @@ impl LeafTest for WholePacket {
         mut rays: u32,
         counters: &mut C,
     ) {
-        // SAFETY: `WholePacket` is only made for structures whose instruction set is AVX-512,
+        // SAFETY: a `WholePacket<B>` is only made for structures whose instruction set is `B`'s,
         // which the processor has (see `Isa`).
         unsafe { leaves.test_blocks(first, count, rays, true, counters) };
         // Every ray asked again (the packet gave up): its limits stay below zero, which ends
@@ -320,8 +326,8 @@ impl LeafTest for RayByRay {
         counters: &mut C,
     ) {
         // The rays' triangle constants are prepared at each leaf, in the portable form (a
-        // closure is compiled without the walk's target features): only processors without
-        // AVX-512 come here.
+        // closure is compiled without the walk's target features): only the portable walk
+        // (processors without AVX2, and other architectures) comes here.
         while rays != 0 {
             let i = take_lowest(&mut rays);
             let source = leaves.packet.ray(i);
