@@ -139,6 +139,10 @@ impl PacketBest {
 /// [`Avx2Block`]): what a packet walk compiled for that set tests its leaves with.
 #[cfg(target_arch = "x86_64")]
 pub trait BlockTest: Copy {
+    /// Rays at most for which a leaf is tested ray by ray instead, with the single-ray block
+    /// test (see `triangle_packet_leaves`).
+    const ALONE: u32;
+
     /// Tests the rays of `rays` against every used triangle of `block`, as
     /// [`block_avx512`] does.
     ///
@@ -159,6 +163,10 @@ pub trait BlockTest: Copy {
 #[derive(Clone, Copy, Debug)]
 pub struct Avx512Block;
 
+/// [`BlockTest::ALONE`] of [`Avx2Block`].
+#[cfg(target_arch = "x86_64")]
+const ALONE_AVX2: u32 = 3;
+
 /// The test with AVX2: the sixteen rays in two vectors of eight.
 #[cfg(target_arch = "x86_64")]
 #[derive(Clone, Copy, Debug)]
@@ -166,6 +174,8 @@ pub struct Avx2Block;
 
 #[cfg(target_arch = "x86_64")]
 impl BlockTest for Avx512Block {
+    const ALONE: u32 = 0;
+
     #[inline(always)]
     unsafe fn block(
         block: &TriBlock,
@@ -182,6 +192,8 @@ impl BlockTest for Avx512Block {
 
 #[cfg(target_arch = "x86_64")]
 impl BlockTest for Avx2Block {
+    const ALONE: u32 = ALONE_AVX2;
+
     #[inline(always)]
     unsafe fn block(
         block: &TriBlock,

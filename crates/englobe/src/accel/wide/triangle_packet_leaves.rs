@@ -32,6 +32,10 @@ use super::packet_triangles::{PacketBest, PacketTriRays};
 use super::traverse::{Leaves, take_lowest};
 use super::triangle_bvh::TriangleBvh;
 use super::triangle_leaves;
+#[cfg(target_arch = "x86_64")]
+use super::triangles::{LANES, TriRay, UNUSED, intersect_block};
+#[cfg(target_arch = "x86_64")]
+use crate::PrimHit;
 use crate::accel::{Counters, Hit, NoFilter};
 use crate::geom::prefetch::prefetch;
 #[cfg(target_arch = "x86_64")]
@@ -138,6 +142,10 @@ impl<B: BlockTest> TrianglePacket<'_, WholePacket<B>> {
         closest: bool,
         counters: &mut C,
     ) -> u32 {
+        if rays.count_ones() <= B::ALONE {
+            // SAFETY: the caller's guarantee: `B`'s instruction set, which has AVX.
+            return unsafe { self.test_blocks_each(first, count, rays, closest, counters) };
+        }
         if self.test.tri.is_none() {
             match PacketTriRays::shared_axes(self.packet, self.test.active) {
                 Some(axes) => self.test.tri = Some(PacketTriRays::new(self.packet, self.test.active, axes)),
@@ -175,6 +183,72 @@ impl<B: BlockTest> TrianglePacket<'_, WholePacket<B>> {
             }
         }
         found
+    }
+
+    /// [`Self::test_blocks`] for a leaf that few rays reach ([`BlockTest::ALONE`]): each ray
+    /// against the blocks with the single-ray block test, four triangles at once, where the
+    /// whole-packet test would run a vector of rays per triangle, most of its lanes idle. Both
+    /// tests compute the scalar test's answer lane by lane, the hits are offered by the same
+    /// rule and the undecided pairs noted alike, so a ray's answer does not depend on which test
+    /// a leaf took.
+    ///
+    /// # Safety
+    /// The processor has AVX (the test is compiled into the caller, which should enable it).
+    #[inline(always)]
+    unsafe fn test_blocks_each<C: Counters>(
+        &mut self,
+        first: u32,
+        count: u32,
+        rays: u32,
+        closest: bool,
+        counters: &mut C,
+    ) -> u32 {
+        let (mut found, mut rest) = (0, rays);
+        while rest != 0 {
+            let i = take_lowest(&mut rest);
+            // SAFETY: the caller's guarantee.
+            let r = unsafe { TriRay::new_avx(&self.packet.ray(i)) };
+            for (b, block) in self.bvh.blocks()[first as usize..(first + count) as usize].iter().enumerate() {
+                for _ in 0..block.used() {
+                    counters.exact_test();
+                }
+                let Some(hits) = intersect_block(block, &r, self.best.t.0[i]) else { continue };
+                // An unused lane repeats the first: the whole-packet test skips it.
+                let used = (0..LANES).filter(|&lane| block.ids[lane] != UNUSED).fold(0, |m, lane| m | 1 << lane);
+                let mut special = hits.special & used;
+                while special != 0 {
+                    let lane = take_lowest(&mut special);
+                    self.note(first + b as u32, (PACKET * lane + i) as u8);
+                }
+                let mut hit = hits.hit & used;
+                if hit == 0 {
+                    continue;
+                }
+                found |= 1 << i;
+                if !closest {
+                    break;
+                }
+                while hit != 0 {
+                    let lane = take_lowest(&mut hit);
+                    let PrimHit { t, u, v } = hits.lane(lane);
+                    self.best.offer(i, Hit { t, prim: block.ids[lane], u, v });
+                }
+            }
+        }
+        found
+    }
+
+    /// Notes the undecided pair `bit` (`16 * lane + ray`) of the block at `block`, or asks its
+    /// ray again if the list is full.
+    #[inline(always)]
+    fn note(&mut self, block: u32, bit: u8) {
+        let WholePacket { noted, len, again, .. } = &mut self.test;
+        if *len < DEFERRED {
+            noted[*len] = (block, bit);
+            *len += 1;
+        } else {
+            *again |= 1 << (bit as usize % PACKET);
+        }
     }
 
     /// Ends the walk of a packet whose rays do not share the test's axes (the tiles of an image
