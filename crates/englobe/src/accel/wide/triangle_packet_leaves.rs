@@ -142,7 +142,8 @@ impl<B: BlockTest> TrianglePacket<'_, WholePacket<B>> {
         closest: bool,
         counters: &mut C,
     ) -> u32 {
-        if rays.count_ones() <= B::ALONE {
+        // (`ALONE` 0 leaves the other test out of the walk altogether.)
+        if B::ALONE > 0 && rays.count_ones() <= B::ALONE {
             // SAFETY: the caller's guarantee: `B`'s instruction set, which has AVX.
             return unsafe { self.test_blocks_each(first, count, rays, closest, counters) };
         }
