@@ -1,7 +1,8 @@
 //! Packets of rays on [`TriangleBvh`]: up to [`PACKET`] rays walk the tree together (see
 //! [`super::packet`]); at a leaf, each triangle is tested against the whole packet when the
-//! processor has AVX-512 (see [`super::packet_triangles`]; a packet whose rays do not share the
-//! watertight test's axes is asked again ray by ray), each ray tests the blocks alone otherwise
+//! processor has AVX-512 or AVX2 (see [`super::packet_triangles`]; a packet whose rays do not
+//! share the watertight test's axes is asked again ray by ray, and with AVX2 a leaf that few of
+//! its rays reach is tested ray by ray), each ray tests the blocks alone in the portable walk
 //! (the leaves' tests are in `triangle_packet_leaves`). Either way every ray gets exactly the
 //! answer of its own query. Batches choose, sixteen rays at a time, between a packet (coherent
 //! rays: near origins, near directions) and single rays.
