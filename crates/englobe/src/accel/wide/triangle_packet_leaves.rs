@@ -172,12 +172,7 @@ impl<B: BlockTest> TrianglePacket<'_, WholePacket<B>> {
             while special != 0 {
                 let bit = special.trailing_zeros();
                 special &= special - 1;
-                if *len < DEFERRED {
-                    noted[*len] = (first + b as u32, bit as u8);
-                    *len += 1;
-                } else {
-                    *again |= 1 << (bit as usize % PACKET);
-                }
+                note((noted, len, again), first + b as u32, bit as u8);
             }
             if !closest && found == rays {
                 break;
@@ -219,7 +214,8 @@ impl<B: BlockTest> TrianglePacket<'_, WholePacket<B>> {
                 let mut special = hits.special & used;
                 while special != 0 {
                     let lane = take_lowest(&mut special);
-                    self.note(first + b as u32, (PACKET * lane + i) as u8);
+                    let WholePacket { noted, len, again, .. } = &mut self.test;
+                    note((noted, len, again), first + b as u32, (PACKET * lane + i) as u8);
                 }
                 let mut hit = hits.hit & used;
                 if hit == 0 {
@@ -237,19 +233,6 @@ impl<B: BlockTest> TrianglePacket<'_, WholePacket<B>> {
             }
         }
         found
-    }
-
-    /// Notes the undecided pair `bit` (`16 * lane + ray`) of the block at `block`, or asks its
-    /// ray again if the list is full.
-    #[inline(always)]
-    fn note(&mut self, block: u32, bit: u8) {
-        let WholePacket { noted, len, again, .. } = &mut self.test;
-        if *len < DEFERRED {
-            noted[*len] = (block, bit);
-            *len += 1;
-        } else {
-            *again |= 1 << (bit as usize % PACKET);
-        }
     }
 
     /// Ends the walk of a packet whose rays do not share the test's axes (the tiles of an image
@@ -310,6 +293,20 @@ impl<B: BlockTest> TrianglePacket<'_, WholePacket<B>> {
             }
         }
         found
+    }
+}
+
+/// Notes the undecided pair `bit` (`16 * lane + ray`) of the block at `block` in a
+/// [`WholePacket`]'s list (its pairs, how many it holds, and the rays asked again), or asks the
+/// pair's ray again if the list is full.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+fn note((noted, len, again): (&mut [(u32, u8); DEFERRED], &mut usize, &mut u32), block: u32, bit: u8) {
+    if *len < DEFERRED {
+        noted[*len] = (block, bit);
+        *len += 1;
+    } else {
+        *again |= 1 << (bit as usize % PACKET);
     }
 }
 
