@@ -60,6 +60,21 @@ pub(super) struct TriangleLeaves<'a, F> {
     met: usize,
 }
 
+/// [`intersect_block`] of `block` within `ray.t_min..=t_max`, its used lanes counted as exact
+/// tests.
+#[inline(always)]
+pub(super) fn counted_block_test<C: Counters>(
+    block: &TriBlock,
+    ray: &TriRay,
+    t_max: f32,
+    counters: &mut C,
+) -> Option<BlockHits> {
+    for _ in 0..block.used() {
+        counters.exact_test();
+    }
+    intersect_block(block, ray, t_max)
+}
+
 /// The closest hit of `source` within `source.t_min..=t_max` among `blocks`, accepted by `filter`,
 /// as `walk` finds it (a walk of the tree that ends with [`Leaves::settle_closest`]).
 #[inline(always)]
@@ -219,10 +234,7 @@ impl<'a, F: HitFilter<Hit>> TriangleLeaves<'a, F> {
     /// lane passed its edge tests.
     #[inline(always)]
     fn test<C: Counters>(&self, block: &TriBlock, ray: &TriRay, counters: &mut C) -> Option<BlockHits> {
-        for _ in 0..block.used() {
-            counters.exact_test();
-        }
-        intersect_block(block, ray, self.t_max)
+        counted_block_test(block, ray, self.t_max, counters)
     }
 
     /// Notes the undecided lanes `special` of the block at `index`, as far as the list holds them.

@@ -33,7 +33,7 @@ use super::traverse::{Leaves, take_lowest};
 use super::triangle_bvh::TriangleBvh;
 use super::triangle_leaves;
 #[cfg(target_arch = "x86_64")]
-use super::triangles::{LANES, TriRay, UNUSED, intersect_block};
+use super::triangles::TriRay;
 #[cfg(target_arch = "x86_64")]
 use crate::PrimHit;
 use crate::accel::{Counters, Hit, NoFilter};
@@ -205,12 +205,11 @@ impl<B: BlockTest> TrianglePacket<'_, WholePacket<B>> {
             // SAFETY: the caller's guarantee.
             let r = unsafe { TriRay::new_avx(&self.packet.ray(i)) };
             for (b, block) in self.bvh.blocks()[first as usize..(first + count) as usize].iter().enumerate() {
-                for _ in 0..block.used() {
-                    counters.exact_test();
-                }
-                let Some(hits) = intersect_block(block, &r, self.best.t.0[i]) else { continue };
+                let Some(hits) = triangle_leaves::counted_block_test(block, &r, self.best.t.0[i], counters) else {
+                    continue;
+                };
                 // An unused lane repeats the first: the whole-packet test skips it.
-                let used = (0..LANES).filter(|&lane| block.ids[lane] != UNUSED).fold(0, |m, lane| m | 1 << lane);
+                let used = block.used_lanes();
                 let mut special = hits.special & used;
                 while special != 0 {
                     let lane = take_lowest(&mut special);

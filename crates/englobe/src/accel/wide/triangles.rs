@@ -73,6 +73,13 @@ impl TriBlock {
     pub fn used(&self) -> u32 {
         self.ids.iter().filter(|&&id| id != UNUSED).count() as u32
     }
+
+    /// The used lanes, bit per lane (an unused lane repeats the first's triangle: a test of the
+    /// block leaves it out).
+    #[inline(always)]
+    pub fn used_lanes(&self) -> u32 {
+        (0..LANES).filter(|&lane| self.ids[lane] != UNUSED).fold(0, |m, lane| m | 1 << lane)
+    }
 }
 
 /// Whether the triangle can ever be hit (it has an area): the rule of the scalar test.
