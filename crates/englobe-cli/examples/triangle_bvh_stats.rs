@@ -78,7 +78,7 @@ fn main() -> anyhow::Result<()> {
             let mut c = WorkCounts::default();
             let hits = rays.iter().filter(|ray| hit(ray, &mut c)).count();
             println!(
-                "  {query}: {:.1} wide nodes and {:.1} triangles tested per ray ({:.1} % hit)",
+                "  {query}: {:.2} wide nodes and {:.2} triangles tested per ray ({:.1} % hit)",
                 c.nodes_visited as f64 / n,
                 c.exact_tests as f64 / n,
                 100.0 * hits as f64 / n

@@ -2,7 +2,8 @@
 //! (see [`super::isa`]). Each computes, per child, exactly what the scalar robust slab test
 //! computes ([`super::node::child_entry_scalar`], Williams, Barrus, Morley and Shirley (2005) with
 //! the far distance scaled as in Ize (2013), "Robust BVH Ray Traversal", the scale folded into the
-//! ray's inverse direction): the same subtractions and products in the same order, and the same handling of NaN (an origin on the plane of a parallel
+//! ray's inverse direction): the same subtractions (the plane from the origin) and products (by
+//! the negated inverse) in the same order, and the same handling of NaN (an origin on the plane of a parallel
 //! ray leaves the interval unchanged). The x86 `max`/`min` instructions return their second operand
 //! when either is NaN, which is the scalar test's `if t_near > enter { t_near } else { enter }`;
 //! the portable kernel spells that comparison out, because NEON's `max` propagates NaN instead.
@@ -80,9 +81,9 @@ fn portable_slabs<const EXITS: bool>(node: &WideNode, ray: &NodeRay, limit: f32,
             let row = |r: usize| Vec4::from_slice(&node.bounds[r][4 * half..4 * half + 4]);
             let (mut enter, mut exit) = (Vec4::splat(ray.t_min), Vec4::splat(limit));
             for a in 0..3 {
-                let (o, inv) = (Vec4::splat(ray.origin[a]), Vec4::splat(ray.inv_dir[a]));
-                let t_near = (row(ray.row_index(a, 0)) - o) * inv;
-                let t_far = (row(ray.row_index(a, 1)) - o) * Vec4::splat(ray.inv_far[a]);
+                let (o, inv) = (Vec4::splat(ray.origin[a]), Vec4::splat(-ray.inv_dir[a]));
+                let t_near = (o - row(ray.row_index(a, 0))) * inv;
+                let t_far = (o - row(ray.row_index(a, 1))) * Vec4::splat(-ray.inv_far[a]);
                 enter = Vec4::select(t_near.cmpgt(enter), t_near, enter);
                 exit = Vec4::select(t_far.cmplt(exit), t_far, exit);
             }
@@ -117,13 +118,15 @@ mod x86 {
             let mut exit = _mm256_set1_ps(limit);
             for a in 0..3 {
                 let o = _mm256_set1_ps(ray.origin[a]);
-                let inv = _mm256_set1_ps(ray.inv_dir[a]);
-                let inv_far = _mm256_set1_ps(ray.inv_far[a]);
+                // Negated, so that each row is subtracted from the origin straight from memory
+                // (see `child_entry_scalar`); made once per query, outside the walk's loop.
+                let inv = _mm256_set1_ps(-ray.inv_dir[a]);
+                let inv_far = _mm256_set1_ps(-ray.inv_far[a]);
                 // The rows at the byte offsets the ray holds: no index check, no shift per row.
                 let near = _mm256_load_ps(ray.row(node, a, 0).as_ptr());
                 let far = _mm256_load_ps(ray.row(node, a, 1).as_ptr());
-                let t_near = _mm256_mul_ps(_mm256_sub_ps(near, o), inv);
-                let t_far = _mm256_mul_ps(_mm256_sub_ps(far, o), inv_far);
+                let t_near = _mm256_mul_ps(_mm256_sub_ps(o, near), inv);
+                let t_far = _mm256_mul_ps(_mm256_sub_ps(o, far), inv_far);
                 // `max(a, b)` is `a > b ? a : b`, `b` when either is NaN: the scalar rule.
                 enter = _mm256_max_ps(t_near, enter);
                 exit = _mm256_min_ps(t_far, exit);
@@ -300,7 +303,7 @@ mod tests {
         for slot in (0..WIDTH).filter(|&slot| mask >> slot & 1 != 0) {
             let mut exit = limit;
             for a in 0..3 {
-                let t_far = (node.bounds[r.row_index(a, 1)][slot] - r.origin[a]) * r.inv_far[a];
+                let t_far = (r.origin[a] - node.bounds[r.row_index(a, 1)][slot]) * -r.inv_far[a];
                 exit = if t_far < exit { t_far } else { exit };
             }
             assert_eq!(exits[slot].to_bits(), exit.to_bits(), "{isa}: slot {slot} of {node:?}, {ray:?}");

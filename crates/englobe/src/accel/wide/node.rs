@@ -221,12 +221,18 @@ pub fn may_enter(bounds: &Aabb, ray: &Ray, limit: f32) -> bool {
 /// times between the exact `(far - o) / d` and the result (the reciprocal, the difference and two
 /// products), each by at most half an ulp, so Ize's bound, and with it the guarantee that a box the
 /// ray meets is never missed, holds for both; the folded form saves a product per axis per node.
+///
+/// Each distance is written `(o - plane) * -inv`, not `(plane - o) * inv`: the same number
+/// (rounding to nearest is symmetric, so `o - plane` is exactly `-(plane - o)`), but for the sign
+/// of a zero where the plane passes through the origin, which no comparison sees. In that order
+/// an x86 kernel subtracts the plane straight from memory (the second operand of `vsubps` may be
+/// a memory operand, the first may not): one instruction fewer per plane, six per node.
 #[inline(always)]
 pub fn child_entry_scalar(node: &WideNode, slot: usize, ray: &NodeRay, limit: f32) -> Option<f32> {
     let (mut enter, mut exit) = (ray.t_min, limit);
     for a in 0..3 {
-        let t_near = (node.bounds[ray.row_index(a, 0)][slot] - ray.origin[a]) * ray.inv_dir[a];
-        let t_far = (node.bounds[ray.row_index(a, 1)][slot] - ray.origin[a]) * ray.inv_far[a];
+        let t_near = (ray.origin[a] - node.bounds[ray.row_index(a, 0)][slot]) * -ray.inv_dir[a];
+        let t_far = (ray.origin[a] - node.bounds[ray.row_index(a, 1)][slot]) * -ray.inv_far[a];
         enter = if t_near > enter { t_near } else { enter };
         exit = if t_far < exit { t_far } else { exit };
     }

@@ -94,8 +94,8 @@ impl PacketKernel for ScalarPacket {
                         let down = (rays.down[a] >> i & 1) as usize;
                         let (near_row, far_row) = (2 * a + down, 2 * a + 1 - down);
                         let o = rays.origin[a].0[i];
-                        let t_near = (node.bounds[near_row][c] - o) * rays.inv_dir[a].0[i];
-                        let t_far = (node.bounds[far_row][c] - o) * rays.inv_far[a].0[i];
+                        let t_near = (o - node.bounds[near_row][c]) * -rays.inv_dir[a].0[i];
+                        let t_far = (o - node.bounds[far_row][c]) * -rays.inv_far[a].0[i];
                         enter = if t_near > enter { t_near } else { enter };
                         exit = if t_far < exit { t_far } else { exit };
                     }
@@ -168,9 +168,14 @@ mod x86 {
             // 64 bytes aligned to 64, so the aligned loads and stores are in bounds and aligned.
             unsafe {
                 let load = |l: &Lanes| _mm512_load_ps(l.0.as_ptr());
+                // The inverses negated, so that each plane is subtracted from the origins straight
+                // from memory, broadcast by the subtraction (see `child_entry_scalar`). The walk
+                // keeps them in registers from node to node: the negation is made once.
+                let sign = _mm512_set1_epi32(i32::MIN);
+                let negated = |l: &Lanes| _mm512_castsi512_ps(_mm512_xor_si512(_mm512_castps_si512(load(l)), sign));
                 let o = [load(&rays.origin[0]), load(&rays.origin[1]), load(&rays.origin[2])];
-                let inv = [load(&rays.inv_dir[0]), load(&rays.inv_dir[1]), load(&rays.inv_dir[2])];
-                let inv_far = [load(&rays.inv_far[0]), load(&rays.inv_far[1]), load(&rays.inv_far[2])];
+                let inv = [negated(&rays.inv_dir[0]), negated(&rays.inv_dir[1]), negated(&rays.inv_dir[2])];
+                let inv_far = [negated(&rays.inv_far[0]), negated(&rays.inv_far[1]), negated(&rays.inv_far[2])];
                 let down = rays.down.map(|d| d as __mmask16);
                 let (t_min, lim) = (load(&rays.t_min), load(limit));
                 let nan = _mm512_set1_ps(f32::NAN);
@@ -189,12 +194,12 @@ mod x86 {
                             let near = _mm512_set1_ps(node.bounds[2 * a + rows[a]][c]);
                             let far = _mm512_set1_ps(node.bounds[2 * a + 1 - rows[a]][c]);
                             (
-                                _mm512_mul_ps(_mm512_sub_ps(near, o[a]), inv[a]),
-                                _mm512_mul_ps(_mm512_sub_ps(far, o[a]), inv_far[a]),
+                                _mm512_mul_ps(_mm512_sub_ps(o[a], near), inv[a]),
+                                _mm512_mul_ps(_mm512_sub_ps(o[a], far), inv_far[a]),
                             )
                         } else {
-                            let lo = _mm512_sub_ps(_mm512_set1_ps(node.bounds[2 * a][c]), o[a]);
-                            let hi = _mm512_sub_ps(_mm512_set1_ps(node.bounds[2 * a + 1][c]), o[a]);
+                            let lo = _mm512_sub_ps(o[a], _mm512_set1_ps(node.bounds[2 * a][c]));
+                            let hi = _mm512_sub_ps(o[a], _mm512_set1_ps(node.bounds[2 * a + 1][c]));
                             // The lanes going down take the upper plane as the near one.
                             (
                                 _mm512_mul_ps(_mm512_mask_blend_ps(down[a], lo, hi), inv[a]),
@@ -258,11 +263,17 @@ mod x86 {
                     // entered child's distances is written.
                     let active_h = (active >> (HALF * h)) & 0xff;
                     let load = |l: &Lanes| _mm256_load_ps(l.0.as_ptr().add(HALF * h));
+                    // The inverses negated, as the scalar test has them (see `child_entry_scalar`;
+                    // AVX2 cannot subtract a broadcast plane from memory, so this kernel gains
+                    // nothing from the order and pays six sign flips per half).
+                    let sign = _mm256_castsi256_ps(_mm256_set1_epi32(i32::MIN));
+                    let negated = |l: &Lanes| _mm256_xor_ps(load(l), sign);
                     let o = [load(&rays.origin[0]), load(&rays.origin[1]), load(&rays.origin[2])];
-                    let inv = [load(&rays.inv_dir[0]), load(&rays.inv_dir[1]), load(&rays.inv_dir[2])];
-                    let inv_far = [load(&rays.inv_far[0]), load(&rays.inv_far[1]), load(&rays.inv_far[2])];
-                    // All ones in the lanes going down (`inv < 0`, as `PacketRays::down` says).
-                    let down = inv.map(|v| _mm256_cmp_ps::<_CMP_LT_OQ>(v, zero));
+                    let inv = [negated(&rays.inv_dir[0]), negated(&rays.inv_dir[1]), negated(&rays.inv_dir[2])];
+                    let inv_far = [negated(&rays.inv_far[0]), negated(&rays.inv_far[1]), negated(&rays.inv_far[2])];
+                    // All ones in the lanes going down (`inv < 0`, as `PacketRays::down` says; the
+                    // negated inverse above zero).
+                    let down = inv.map(|v| _mm256_cmp_ps::<_CMP_GT_OQ>(v, zero));
                     let (t_min, lim) = (load(&rays.t_min), load(limit));
                     let mut left = candidates;
                     while left != 0 {
@@ -270,8 +281,8 @@ mod x86 {
                         left &= left - 1;
                         let (mut enter, mut exit) = (t_min, lim);
                         for a in 0..3 {
-                            let lo = _mm256_sub_ps(_mm256_set1_ps(node.bounds[2 * a][c]), o[a]);
-                            let hi = _mm256_sub_ps(_mm256_set1_ps(node.bounds[2 * a + 1][c]), o[a]);
+                            let lo = _mm256_sub_ps(o[a], _mm256_set1_ps(node.bounds[2 * a][c]));
+                            let hi = _mm256_sub_ps(o[a], _mm256_set1_ps(node.bounds[2 * a + 1][c]));
                             let t_near = _mm256_mul_ps(_mm256_blendv_ps(lo, hi, down[a]), inv[a]);
                             let t_far = _mm256_mul_ps(_mm256_blendv_ps(hi, lo, down[a]), inv_far[a]);
                             enter = _mm256_max_ps(t_near, enter);
