@@ -192,10 +192,11 @@ pub fn reach(t_max: f32) -> f32 {
 
 /// Whether `ray` may enter `bounds` within `t_min..=limit`: a slab test of one box, done with
 /// three-lane vectors before any per-query state is prepared, so that a query whose ray passes
-/// beside the whole tree costs a few instructions. It computes each plane's distance exactly as
-/// the node test does (the same differences and products), so for a box inside `bounds` it never
-/// says no where the node test would say yes: rounding is monotonic, so the outer box's entry is
-/// no later and its exit no earlier. A NaN distance (an origin on the plane of a parallel ray)
+/// beside the whole tree costs a few instructions. It computes each plane's distance as the node
+/// test does (the same numbers: the node test's differences and factors are negated, which
+/// changes at most the sign of a zero), so for a box inside `bounds` it never says no where the
+/// node test would say yes: rounding is monotonic, so the outer box's entry is no later and its
+/// exit no earlier. A NaN distance (an origin on the plane of a parallel ray)
 /// constrains nothing, as in the node test.
 #[inline(always)]
 pub fn may_enter(bounds: &Aabb, ray: &Ray, limit: f32) -> bool {

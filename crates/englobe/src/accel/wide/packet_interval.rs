@@ -6,7 +6,8 @@
 //! Methods for Entire Ray Packets" (University of Utah, UUCS-06-010), on eight boxes at once.
 //!
 //! Each ray's slab test ([`super::node::child_entry_scalar`]) computes per axis
-//! `t_near = (near - o) * inv` and `t_far = (far - o) * inv_far`, rounded. When the packet's rays
+//! `t_near = (near - o) * inv` and `t_far = (far - o) * inv_far`, rounded (it writes them
+//! `(o - near) * -inv`, the same numbers but for the sign of a zero). When the packet's rays
 //! all go the same way along every axis (a camera's tile), each axis's near and far planes are the
 //! same rows for all of them, and since rounding is monotonic each ray's distances lie within what
 //! the extreme origins and inverse directions give:
