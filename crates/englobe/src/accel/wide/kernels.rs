@@ -3,10 +3,11 @@
 //! computes ([`super::node::child_entry_scalar`], Williams, Barrus, Morley and Shirley (2005) with
 //! the far distance scaled as in Ize (2013), "Robust BVH Ray Traversal", the scale folded into the
 //! ray's inverse direction): the same subtractions (the plane from the origin) and products (by
-//! the negated inverse) in the same order, and the same handling of NaN (an origin on the plane of a parallel
-//! ray leaves the interval unchanged). The x86 `max`/`min` instructions return their second operand
-//! when either is NaN, which is the scalar test's `if t_near > enter { t_near } else { enter }`;
-//! the portable kernel spells that comparison out, because NEON's `max` propagates NaN instead.
+//! the negated inverse) in the same order, and the same handling of NaN (an origin on the plane of
+//! a parallel ray leaves the interval unchanged). The x86 `max`/`min` instructions return their
+//! second operand when either is NaN, which is the scalar test's
+//! `if t_near > enter { t_near } else { enter }`; the portable kernel spells that comparison out,
+//! because NEON's `max` propagates NaN instead.
 //!
 //! For the rays to which it applies, the AVX-512 walk tests nodes in a fused form instead
 //! ([`Avx512Fused`], see [`super::fused`]), matched bit for bit by its own scalar reference.

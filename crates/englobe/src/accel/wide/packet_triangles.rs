@@ -1,10 +1,10 @@
 //! The watertight triangle test (Woop, Benthin and Wald 2013) of one triangle against a whole
-//! packet at once: sixteen rays in the lanes of an AVX-512 vector (of two AVX2 vectors), the
-//! triangle's coordinates broadcast, as Embree's hybrid traversal tests its `Triangle4` leaves against ray packets (Wald
-//! et al. 2014). The test shears each ray's frame by its own axes; a packet whose rays share the
-//! axes (the camera rays of a tile, nearly always) reads the same rows of the block for every
-//! lane, so only those packets take this path. The others are asked again one ray at a time
-//! (see `triangle_packet_leaves`).
+//! packet at once: sixteen rays in the lanes of an AVX-512 vector (or of two AVX2 vectors), the
+//! triangle's coordinates broadcast, as Embree's hybrid traversal tests its `Triangle4` leaves
+//! against ray packets (Wald et al. 2014). The test shears each ray's frame by its own axes; a
+//! packet whose rays share the axes (the camera rays of a tile, nearly always) reads the same
+//! rows of the block for every lane, so only those packets take this path. The others are asked
+//! again one ray at a time (see `triangle_packet_leaves`).
 //!
 //! Each lane computes exactly what a lane of the single-ray block test
 //! ([`super::triangles::intersect_block`]) computes for its ray and triangle: the same operations

@@ -71,7 +71,7 @@ impl TriBlock {
     /// Number of used lanes.
     #[inline(always)]
     pub fn used(&self) -> u32 {
-        self.ids.iter().filter(|&&id| id != UNUSED).count() as u32
+        self.used_lanes().count_ones()
     }
 
     /// The used lanes, bit per lane (an unused lane repeats the first's triangle: a test of the
