@@ -274,6 +274,53 @@ fn stanford_bunny_in_every_instruction_set() {
     assert!(counts.exact_tests * 500 < brute_tests, "{} exact tests, brute force {brute_tests}", counts.exact_tests);
 }
 
+/// Struts cut by the presplit among triangles the build leaves out (zero areas, a NaN): the
+/// fragments name their triangles by the indices the caller gave, not by their places among the
+/// triangles kept, and every query stays brute force's.
+#[test]
+fn cut_triangles_among_left_out_ones_keep_their_indices() {
+    use englobe::Aabb;
+    use englobe::accel::Validate;
+
+    let mut rng = seeded(43);
+    let mut tris: Vec<[Vec3; 3]> = Vec::new();
+    let mut struts = Vec::new();
+    for k in 0..460 {
+        match k % 23 {
+            0 => tris.push([Vec3::splat(k as f32 * 0.01); 3]),
+            1 => tris.push([Vec3::new(f32::NAN, 0.0, 0.0), Vec3::X, Vec3::Y]),
+            2 => {
+                let (a, b) = (in_cube(&mut rng) * 4.0, in_cube(&mut rng) * 4.0);
+                struts.push(tris.len());
+                tris.push([a, b, b + in_cube(&mut rng) * 0.1]);
+            }
+            _ => {
+                let c = in_cube(&mut rng) * 4.0;
+                tris.push([c, c + in_cube(&mut rng) * 0.05, c + in_cube(&mut rng) * 0.05]);
+            }
+        }
+    }
+    let bvh = TriangleBvh::from_triangles(&tris);
+    let boxes: Vec<Aabb> = tris.iter().map(|t| Aabb::from_points(*t)).collect();
+    let stats = bvh.validate(&boxes, None).expect("a valid structure");
+    let kept = tris.len() - 2 * tris.len().div_ceil(23);
+    assert!(stats.prim_refs > kept + 10, "{} references for {kept} triangles kept: nothing was cut", stats.prim_refs);
+
+    let bounds = boxes.iter().filter(|b| b.is_finite()).fold(Aabb::EMPTY, |b, t| b.union(t));
+    let mut rays: Vec<Ray> = (0..300).map(|_| ray_into_box(&mut rng, &bounds)).collect();
+    for &i in &struts {
+        let t = tris[i];
+        for k in 0..10 {
+            let s = (k as f32 + 0.5) / 10.0;
+            let target = t[0] + (t[1] - t[0]) * s + (t[2] - t[1]) * (0.5 * s);
+            let origin = in_box(&mut rng, &bounds) * 1.5;
+            rays.push(Ray::new(origin, target - origin));
+        }
+    }
+    let hits = check(&tris, &rays).expect("agreement with brute force");
+    assert!(hits > 150, "{hits} hits");
+}
+
 /// Long diagonal struts among small triangles: the build cuts the struts into pieces that lie in
 /// several leaves (see `englobe::accel::wide::presplit`). The structure stays valid, every query
 /// stays brute force's, and the box query still lists each triangle once.

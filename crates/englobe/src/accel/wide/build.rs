@@ -22,7 +22,7 @@ use super::node::{LEAF, MAX_LEAF_ITEMS, WideNode};
 use super::output::{LeafSink, WideLayout};
 use super::pieces::{Pieces, Store};
 use crate::Aabb;
-use crate::accel::bvh::build::parallel::{self, collect_indexed};
+use crate::accel::bvh::build::parallel::{self, collect_indexed_huge};
 use crate::accel::bvh::build::top_down::{PARALLEL_MIN, PrimRef, Splitter, decide, range_bounds};
 
 /// Builds the wide tree over `boxes` (primitive `i` has box `boxes[i]`), splitting ranges with
@@ -32,15 +32,15 @@ where
     S: Splitter,
     K: LeafSink + Send + Sync,
 {
-    build_wide_with(splitter, boxes.len(), |i| boxes[i], options, sink)
+    let refs = collect_indexed_huge(boxes.len(), 1 << 14, |i| PrimRef::new(&boxes[i], i as u32));
+    build_wide_refs(splitter, refs, options, sink)
 }
 
-/// [`build_wide`] over `count` primitives whose boxes `box_of` gives (each asked for once), for a
-/// caller that holds them in another form than a list of boxes.
-pub fn build_wide_with<S, K>(
+/// [`build_wide`] over references the caller made (primitive `r.index()` has box `r.bounds()`):
+/// the builder reorders them in place.
+pub fn build_wide_refs<S, K>(
     splitter: &S,
-    count: usize,
-    box_of: impl Fn(usize) -> Aabb + Sync,
+    mut refs: Vec<PrimRef>,
     options: ConvertOptions,
     sink: &mut K,
 ) -> (WideLayout, Aabb)
@@ -48,10 +48,9 @@ where
     S: Splitter,
     K: LeafSink + Send + Sync,
 {
-    if count == 0 {
+    if refs.is_empty() {
         return (WideLayout::default(), Aabb::EMPTY);
     }
-    let mut refs = collect_indexed(count, 1 << 14, |i| PrimRef::new(&box_of(i), i as u32));
     let max_prims = sink.max_prims().clamp(1, MAX_LEAF_ITEMS);
     let builder = Builder { splitter, max_prims, limit: options.collapse.min(max_prims) };
     let root = builder.part(&mut refs, 0, &mut S::Scratch::default());

@@ -91,21 +91,22 @@ impl TriangleBox {
 /// [`MIN_WASTE_SHARE`] of the scene's area are cut. The triangles are cut in parallel; the
 /// fragments come in triangle order, whatever the threads.
 pub fn presplit(triangles: &[TriangleBox], triangle: impl Fn(u32) -> [Vec3; 3] + Sync, budget: f32) -> Fragments {
-    presplit_cuts(triangles, triangle, budget).unwrap_or_else(|| Fragments {
+    presplit_cuts(triangles.len(), |i| triangles[i], triangle, budget).unwrap_or_else(|| Fragments {
         boxes: collect_indexed(triangles.len(), CHUNK, |i| triangles[i].bounds),
         owner: collect_indexed(triangles.len(), CHUNK, |i| i as u32),
     })
 }
 
-/// [`presplit`], or `None` when it would cut no triangle: the fragments would then be the
-/// triangles' own boxes, which a caller that has them need not copy (hundreds of megabytes on a
-/// scene of millions of triangles).
+/// [`presplit`] over `count` triangles described by `describe(i)` (however the caller holds
+/// them), or `None` when it would cut no triangle: the fragments would then be the triangles' own
+/// boxes, which a caller that has them need not copy (hundreds of megabytes on a scene of
+/// millions of triangles).
 pub fn presplit_cuts(
-    triangles: &[TriangleBox],
+    count: usize,
+    describe: impl Fn(usize) -> TriangleBox + Sync,
     triangle: impl Fn(u32) -> [Vec3; 3] + Sync,
     budget: f32,
 ) -> Option<Fragments> {
-    let count = triangles.len();
     // References stay within what a build may hold (its bins count them in `i32` lanes).
     let extra = ((budget.max(0.0) * count as f32) as usize).min(MAX_PRIMITIVES.saturating_sub(count));
     if extra == 0 {
@@ -117,7 +118,7 @@ pub fn presplit_cuts(
     let chunk = |c: usize| c * CHUNK..((c + 1) * CHUNK).min(count);
     let sum = |(s, w): (Aabb, f64), (b, x): (Aabb, f64)| (s.union(&b), w + x);
     let (scene, total) = collect_indexed(chunks, 1, |c| {
-        triangles[chunk(c)].iter().map(|t| (t.bounds, t.waste as f64)).fold((Aabb::EMPTY, 0.0), sum)
+        chunk(c).map(&describe).map(|t| (t.bounds, t.waste as f64)).fold((Aabb::EMPTY, 0.0), sum)
     })
     .into_iter()
     .fold((Aabb::EMPTY, 0.0), sum);
@@ -129,7 +130,7 @@ pub fn presplit_cuts(
     let share = extra as f64 / total;
     let floor = scene.surface_area() * MIN_WASTE_SHARE;
     let pieces = |i: usize| {
-        let waste = triangles[i].waste;
+        let waste = describe(i).waste;
         if waste < floor { 1 } else { (1 + (waste as f64 * share) as usize).min(MAX_PIECES) }
     };
     let cut_ones: Vec<u32> =
@@ -141,20 +142,20 @@ pub fn presplit_cuts(
     let cut_boxes: Vec<Vec<Aabb>> = collect_indexed(cut_ones.len(), 64, |k| {
         let i = cut_ones[k];
         let mut out = Vec::with_capacity(pieces(i as usize));
-        cut(&Polygon::triangle(triangle(i)), triangles[i as usize].bounds, pieces(i as usize), &scene, &mut out);
+        cut(&Polygon::triangle(triangle(i)), describe(i as usize).bounds, pieces(i as usize), &scene, &mut out);
         out
     });
     // The triangles left whole go in runs, between the cut ones' fragments.
     let mut out = Fragments { boxes: Vec::with_capacity(count + extra), owner: Vec::with_capacity(count + extra) };
     let mut whole_from = 0;
     for (&i, parts) in cut_ones.iter().zip(&cut_boxes) {
-        out.boxes.extend(triangles[whole_from..i as usize].iter().map(|t| t.bounds));
+        out.boxes.extend((whole_from..i as usize).map(|k| describe(k).bounds));
         out.owner.extend(whole_from as u32..i);
         out.boxes.extend_from_slice(parts);
         out.owner.extend(std::iter::repeat_n(i, parts.len()));
         whole_from = i as usize + 1;
     }
-    out.boxes.extend(triangles[whole_from..].iter().map(|t| t.bounds));
+    out.boxes.extend((whole_from..count).map(|k| describe(k).bounds));
     out.owner.extend(whole_from as u32..count as u32);
     Some(out)
 }
@@ -284,7 +285,7 @@ mod tests {
         assert!(waste < scene.surface_area() * MIN_WASTE_SHARE);
         let f = presplit(&input, |i| tris[i as usize], 0.4);
         assert_eq!(f.boxes, boxes);
-        assert_eq!(presplit_cuts(&input, |i| tris[i as usize], 0.4), None);
+        assert_eq!(presplit_cuts(input.len(), |i| input[i], |i| tris[i as usize], 0.4), None);
         // The same triangle grown to a fifth of the scene is cut.
         tris[0] = [Vec3::ZERO, Vec3::splat(20.0), Vec3::new(20.0, 18.0, 20.0)];
         let (input, _) = described(&tris);
@@ -311,7 +312,7 @@ mod tests {
         let f = presplit(&input, |i| tris[i as usize], 0.0);
         assert_eq!(f.boxes, boxes);
         assert_eq!(f.owner, vec![0, 1, 2, 3]);
-        assert_eq!(presplit_cuts(&input, |i| tris[i as usize], 0.0), None);
+        assert_eq!(presplit_cuts(input.len(), |i| input[i], |i| tris[i as usize], 0.0), None);
     }
 
     #[test]
@@ -331,7 +332,8 @@ mod tests {
             })
             .collect();
         let (input, boxes) = described(&tris);
-        let f = presplit_cuts(&input, |i| tris[i as usize], 0.1).expect("the large triangles are cut");
+        let f =
+            presplit_cuts(input.len(), |i| input[i], |i| tris[i as usize], 0.1).expect("the large triangles are cut");
         assert!(f.owner.is_sorted(), "fragments in triangle order");
         for i in 0..n {
             let (from, to) =

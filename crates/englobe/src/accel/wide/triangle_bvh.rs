@@ -9,7 +9,7 @@
 
 use glam::Vec3;
 
-use super::build::{build_wide, build_wide_with};
+use super::build::{build_wide, build_wide_refs};
 use super::convert::{ConvertOptions, LeafSink};
 use super::dispatch;
 use super::isa::{Isa, IsaUnavailable};
@@ -18,7 +18,8 @@ use super::presplit::{TriangleBox, presplit_cuts};
 use super::triangle_leaves;
 use super::triangles::{LANES, TriBlock, UNUSED, is_storable};
 use crate::accel::bvh::BinnedSah;
-use crate::accel::bvh::build::parallel::{collect_indexed, collect_indexed_huge, map_chunks};
+use crate::accel::bvh::build::parallel::{collect_indexed_huge, map_chunks};
+use crate::accel::bvh::build::top_down::PrimRef;
 use crate::accel::{Counters, Hit, HitFilter, LEAF_SIZE_BUCKETS, MAX_PRIMITIVES, NoFilter, StructureStats};
 use crate::shapes::{MeshError, TriangleMesh, check_arrays};
 use crate::{Aabb, Ray};
@@ -207,47 +208,44 @@ impl TriangleBvh {
     /// are triangles with non-finite coordinates.
     pub fn build_with(count: usize, triangle: impl Fn(u32) -> [Vec3; 3] + Sync, options: TriangleBvhOptions) -> Self {
         let count = count.min(MAX_PRIMITIVES);
-        // Each triangle's box and the area it wastes, in the one pass that fetches the triangles;
-        // an empty box marks one left out.
-        let described = collect_indexed(count, 1 << 14, |i| {
+        // Each triangle's reference for the build, with the area its box wastes beside it for the
+        // presplit, in the one pass that fetches the triangles; an empty box marks one left out.
+        let mut refs = collect_indexed_huge(count, 1 << 14, |i| {
             let v = triangle(i as u32);
             if v.iter().all(|p| p.is_finite()) && is_storable(&v) {
-                TriangleBox::of(&v)
+                let t = TriangleBox::of(&v);
+                PrimRef::with_spare(&t.bounds, i as u32, t.waste)
             } else {
-                TriangleBox { bounds: Aabb::EMPTY, waste: 0.0 }
+                PrimRef::with_spare(&Aabb::EMPTY, i as u32, 0.0)
             }
         });
-        // The triangles kept, by index, unless all are (then index `i` is triangle `i`).
-        let all_kept =
-            map_chunks(&described, 1 << 14, |c| c.iter().all(|t| t.bounds.is_finite())).into_iter().all(|a| a);
-        let ids: Option<Vec<u32>> =
-            (!all_kept).then(|| (0..count as u32).filter(|&i| described[i as usize].bounds.is_finite()).collect());
-        let kept: Vec<TriangleBox> = match &ids {
-            Some(ids) => ids.iter().map(|&i| described[i as usize]).collect(),
-            None => described,
-        };
-        let id = |k: u32| ids.as_ref().map_or(k, |ids| ids[k as usize]);
+        // The triangles kept, in order (each reference still names its triangle).
+        let all_kept = map_chunks(&refs, 1 << 14, |c| c.iter().all(|r| r.bounds().is_finite())).into_iter().all(|a| a);
+        if !all_kept {
+            refs.retain(|r| r.bounds().is_finite());
+        }
+        let stored = refs.len();
+        let describe = |k: usize| TriangleBox { bounds: refs[k].bounds(), waste: refs[k].spare() };
         let budget = options.presplit_percent as f32 / 100.0;
-        // The fragments, if any triangle is cut; else the build reads the triangles' boxes.
-        let fragments = presplit_cuts(&kept, |k| triangle(id(k)), budget);
-        let stored = kept.len();
+        // The fragments, if any triangle is cut; else the build takes the references as they are.
+        let fragments = presplit_cuts(stored, describe, |k| triangle(refs[k as usize].index()), budget);
         let cut = fragments.as_ref().is_some_and(|f| f.boxes.len() > stored);
-        // The triangle each box of the build names, unless it is the box's own index.
-        let mapped: Option<Vec<u32>> = match (&fragments, &ids) {
-            (Some(f), Some(_)) => Some(f.owner.iter().map(|&k| id(k)).collect()),
-            _ => None,
-        };
-        let owners = mapped.as_deref().or(fragments.as_ref().map(|f| &f.owner[..])).or(ids.as_deref());
-        let mut sink = Blocks { ids: owners, blocks: Vec::new(), leaf_ids: Vec::new() };
-        // Wide nodes straight from the boxes: no binary tree in between. The triangles' own
-        // boxes are kept for the build only if it reads them.
         let options_wide = ConvertOptions { collapse: options.collapse };
-        let (layout, bounds) = match &fragments {
-            Some(f) => {
-                drop(kept);
-                build_wide(&options.builder, &f.boxes, options_wide, &mut sink)
+        // The fragments' boxes and the triangle each names, if some were left out (else a
+        // fragment names its kept index, which is then the triangle's).
+        let (boxes, owners) = match fragments {
+            Some(f) if all_kept => (Some(f.boxes), Some(f.owner)),
+            Some(f) => (Some(f.boxes), Some(f.owner.iter().map(|&k| refs[k as usize].index()).collect())),
+            None => (None, None),
+        };
+        let mut sink = Blocks { ids: owners.as_deref(), blocks: Vec::new(), leaf_ids: Vec::new() };
+        // Wide nodes straight from the boxes: no binary tree in between.
+        let (layout, bounds) = match boxes {
+            Some(boxes) => {
+                drop(refs);
+                build_wide(&options.builder, &boxes, options_wide, &mut sink)
             }
-            None => build_wide_with(&options.builder, stored, |i| kept[i].bounds, options_wide, &mut sink),
+            None => build_wide_refs(&options.builder, refs, options_wide, &mut sink),
         };
         let blocks = sink.fill(&triangle);
         TriangleBvh {

@@ -20,6 +20,17 @@ pub fn join<A: Send, B: Send>(a: impl FnOnce() -> A + Send, b: impl FnOnce() -> 
     }
 }
 
+/// The most elements one task of a parallel map takes, for maps in chunks of at least
+/// `min_chunk`. Rayon cuts a map into about as many tasks as there are threads, and cuts further
+/// only the ones other threads steal: a task already running is never cut, so one that is a
+/// quarter of the map can leave the other threads idle for that long at its end (a profile of a
+/// two-thread build of 8.7 million triangles showed one thread idle for a tenth of a second at
+/// the end of the blocks' filling). Tasks of a few minimal chunks end nearly together.
+#[cfg(feature = "parallel")]
+fn most(min_chunk: usize) -> usize {
+    min_chunk.max(1).saturating_mul(4)
+}
+
 /// Fills `out[i] = f(i)` for every index of `out`, in parallel (in chunks of at least `min_chunk`)
 /// when the `parallel` feature is on and `out` is long enough to be worth it.
 #[inline]
@@ -27,7 +38,11 @@ pub fn fill_indexed<T: Send>(out: &mut [T], min_chunk: usize, f: impl Fn(usize) 
     #[cfg(feature = "parallel")]
     if out.len() > min_chunk {
         use rayon::prelude::*;
-        out.par_iter_mut().with_min_len(min_chunk.max(1)).enumerate().for_each(|(i, o)| *o = f(i));
+        out.par_iter_mut()
+            .with_min_len(min_chunk.max(1))
+            .with_max_len(most(min_chunk))
+            .enumerate()
+            .for_each(|(i, o)| *o = f(i));
         return;
     }
     let _ = min_chunk;
@@ -65,7 +80,12 @@ fn collect_indexed_into<T: Send>(
     if n > min_chunk {
         use rayon::prelude::*;
         // `collect_into_vec` keeps the vector's allocation when its capacity suffices.
-        (0..n).into_par_iter().with_min_len(min_chunk.max(1)).map(&f).collect_into_vec(&mut values);
+        (0..n)
+            .into_par_iter()
+            .with_min_len(min_chunk.max(1))
+            .with_max_len(most(min_chunk))
+            .map(&f)
+            .collect_into_vec(&mut values);
         return values;
     }
     let _ = min_chunk;
@@ -92,7 +112,12 @@ pub fn all_mut<T: Send>(v: &mut [T], min_chunk: usize, f: impl Fn(&mut T) -> boo
     #[cfg(feature = "parallel")]
     if v.len() > min_chunk {
         use rayon::prelude::*;
-        return v.par_iter_mut().with_min_len(min_chunk.max(1)).map(&f).reduce(|| true, |a, b| a & b);
+        return v
+            .par_iter_mut()
+            .with_min_len(min_chunk.max(1))
+            .with_max_len(most(min_chunk))
+            .map(&f)
+            .reduce(|| true, |a, b| a & b);
     }
     let _ = min_chunk;
     v.iter_mut().fold(true, |ok, x| f(x) & ok)
@@ -107,7 +132,7 @@ pub fn map_chunks_mut<T: Send, R: Send>(v: &mut [T], chunk: usize, f: impl Fn(&m
     #[cfg(feature = "parallel")]
     if v.len() > chunk {
         use rayon::prelude::*;
-        return v.par_chunks_mut(chunk).map(&f).collect();
+        return v.par_chunks_mut(chunk).with_max_len(1).map(&f).collect();
     }
     v.chunks_mut(chunk).map(f).collect()
 }
@@ -120,7 +145,7 @@ pub fn map_chunks<T: Sync, R: Send>(v: &[T], chunk: usize, f: impl Fn(&[T]) -> R
     #[cfg(feature = "parallel")]
     if v.len() > chunk {
         use rayon::prelude::*;
-        return v.par_chunks(chunk).map(&f).collect();
+        return v.par_chunks(chunk).with_max_len(1).map(&f).collect();
     }
     v.chunks(chunk).map(f).collect()
 }

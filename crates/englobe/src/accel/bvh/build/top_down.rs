@@ -38,7 +38,7 @@ pub struct PrimRef {
     /// The box's lower corner; the fourth lane holds the index's bits, bit 30 flipped (see
     /// [`INDEX_BITS`]).
     lo: Vec4,
-    /// The box's upper corner (fourth lane unused).
+    /// The box's upper corner; the fourth lane is the caller's (see [`PrimRef::with_spare`]).
     hi: Vec4,
 }
 
@@ -53,6 +53,22 @@ impl PrimRef {
     #[inline]
     pub fn new(bounds: &Aabb, index: u32) -> Self {
         PrimRef { lo: bounds.min.extend(f32::from_bits(index ^ INDEX_BITS)), hi: bounds.max.extend(1.0) }
+    }
+
+    /// The reference of primitive `index` with a number of the caller's about it, `spare`, in
+    /// the upper corner's fourth lane, which no builder reads: the triangle build keeps there the
+    /// area a triangle's box wastes, which the presplit needs, so that the one pass over the
+    /// triangles makes the references, with no second array (hundreds of megabytes on a scene of
+    /// millions of triangles).
+    #[inline]
+    pub fn with_spare(bounds: &Aabb, index: u32, spare: f32) -> Self {
+        PrimRef { lo: bounds.min.extend(f32::from_bits(index ^ INDEX_BITS)), hi: bounds.max.extend(spare) }
+    }
+
+    /// The number given to [`PrimRef::with_spare`] (1.0 for a reference made by [`PrimRef::new`]).
+    #[inline(always)]
+    pub fn spare(&self) -> f32 {
+        self.hi.w
     }
 
     /// The box's lower corner.
