@@ -162,9 +162,11 @@ pub fn build_tree<S: Splitter>(splitter: &S, boxes: &[Aabb]) -> BuildTree {
     if n == 0 {
         return BuildTree::default();
     }
-    let mut refs = parallel::collect_indexed(n, 1 << 14, |i| PrimRef::new(&boxes[i], i as u32));
+    // Both on huge pages: hundreds of megabytes on a large scene, read again at every level, a
+    // page fault per 4 KiB otherwise (see `crate::geom::huge_pages`).
+    let mut refs = parallel::collect_indexed_huge(n, 1 << 14, |i| PrimRef::new(&boxes[i], i as u32));
     let unused = BuildNode { bounds: Aabb::EMPTY, kind: BuildKind::Leaf { first: 0, count: 0 } };
-    let mut nodes = parallel::collect_indexed(2 * n - 1, 1 << 14, |_| unused);
+    let mut nodes = parallel::collect_indexed_huge(2 * n - 1, 1 << 14, |_| unused);
     build_parallel(splitter, &mut nodes, 0, &mut refs, 0, 0);
     let prims = parallel::collect_indexed(n, 1 << 14, |i| refs[i].index());
     BuildTree { nodes, prims, root: 0 }
