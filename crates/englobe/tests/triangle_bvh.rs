@@ -274,6 +274,26 @@ fn stanford_bunny_in_every_instruction_set() {
     assert!(counts.exact_tests * 500 < brute_tests, "{} exact tests, brute force {brute_tests}", counts.exact_tests);
 }
 
+/// Ten rays into each of `struts`, from random points around `bounds`, aimed at points inside the
+/// strut along its length (crossing the presplit's cuts), not at a vertex or on an edge, where an
+/// isolated triangle is hit or missed by a rounding.
+fn rays_into_struts<'a>(
+    rng: &mut rand_pcg::Pcg32,
+    struts: impl IntoIterator<Item = &'a [Vec3; 3]>,
+    bounds: &englobe::Aabb,
+) -> Vec<Ray> {
+    let mut rays = Vec::new();
+    for t in struts {
+        for k in 0..10 {
+            let s = (k as f32 + 0.5) / 10.0;
+            let target = t[0] + (t[1] - t[0]) * s + (t[2] - t[1]) * (0.5 * s);
+            let origin = in_box(rng, bounds) * 1.5;
+            rays.push(Ray::new(origin, target - origin));
+        }
+    }
+    rays
+}
+
 /// Struts cut by the presplit among triangles the build leaves out (zero areas, a NaN): the
 /// fragments name their triangles by the indices the caller gave, not by their places among the
 /// triangles kept, and every query stays brute force's.
@@ -308,15 +328,7 @@ fn cut_triangles_among_left_out_ones_keep_their_indices() {
 
     let bounds = boxes.iter().filter(|b| b.is_finite()).fold(Aabb::EMPTY, |b, t| b.union(t));
     let mut rays: Vec<Ray> = (0..300).map(|_| ray_into_box(&mut rng, &bounds)).collect();
-    for &i in &struts {
-        let t = tris[i];
-        for k in 0..10 {
-            let s = (k as f32 + 0.5) / 10.0;
-            let target = t[0] + (t[1] - t[0]) * s + (t[2] - t[1]) * (0.5 * s);
-            let origin = in_box(&mut rng, &bounds) * 1.5;
-            rays.push(Ray::new(origin, target - origin));
-        }
-    }
+    rays.extend(rays_into_struts(&mut rng, struts.iter().map(|&i| &tris[i]), &bounds));
     let hits = check(&tris, &rays).expect("agreement with brute force");
     assert!(hits > 150, "{hits} hits");
 }
@@ -362,14 +374,7 @@ fn cut_triangles_are_found_once_and_exactly() {
     // at a vertex or on an edge, where an isolated triangle is hit or missed by a rounding.
     let bounds = boxes.iter().fold(Aabb::EMPTY, |b, t| b.union(t));
     let mut rays: Vec<Ray> = (0..400).map(|_| ray_into_box(&mut rng, &bounds)).collect();
-    for t in &tris[400..] {
-        for k in 0..10 {
-            let s = (k as f32 + 0.5) / 10.0;
-            let target = t[0] + (t[1] - t[0]) * s + (t[2] - t[1]) * (0.5 * s);
-            let origin = in_box(&mut rng, &bounds) * 1.5;
-            rays.push(Ray::new(origin, target - origin));
-        }
-    }
+    rays.extend(rays_into_struts(&mut rng, &tris[400..], &bounds));
     let hits = check(&tris, &rays).expect("agreement with brute force");
     assert!(hits > 300, "{hits} hits");
 
