@@ -39,7 +39,9 @@ def library_name(library, structure):
         return f"Embree {embree.group(1)} `rtcIntersect16`"
     isa = re.search(r"\((\w+)\)", structure)
     if library == "englobe":
-        return f"**englobe** `TriangleBvh` ({isa.group(1).upper().replace('AVX512', 'AVX-512')})" if isa else "**englobe**"
+        if not isa:
+            return "**englobe**"
+        return f"**englobe** `TriangleBvh` ({isa.group(1).upper().replace('AVX512', 'AVX-512')})"
     if library == "englobe-packet16":
         return "englobe, 16-ray packets"
     if library == "obvhs":
@@ -60,13 +62,21 @@ def hit_fractions(log):
 def main():
     if len(sys.argv) not in (2, 3):
         sys.exit(__doc__)
-    rows = list(csv.DictReader(open(sys.argv[1], encoding="utf-8")))
-    hits = hit_fractions(sys.argv[2]) if len(sys.argv) == 3 else {}
+    try:
+        rows = list(csv.DictReader(open(sys.argv[1], encoding="utf-8")))
+        hits = hit_fractions(sys.argv[2]) if len(sys.argv) == 3 else {}
+    except OSError as e:
+        sys.exit(f"anchor-table: {e}")
+    needed = {"scene", "library", "rays", "query", "mrays_per_s", "ratio_to_embree", "build_ms",
+              "build_bytes_per_triangle", "triangles", "structure"}
+    if not rows or not needed <= set(rows[0]):
+        sys.exit(f"anchor-table: {sys.argv[1]} is not a CSV of scripts/bench-anchors.sh "
+                 f"(it needs the columns {', '.join(sorted(needed))})")
     scenes = list(dict.fromkeys(r["scene"] for r in rows))
     libraries = list(dict.fromkeys(r["library"] for r in rows))
     cell = {(r["scene"], r["library"], r["rays"], r["query"]): r for r in rows}
-    print("| scene (triangles; primary rays hitting) | library | build ms | B/tri | primary, closest "
-          "| random, closest | random, any-hit | bounce, closest |")
+    print("| scene (triangles; primary rays hitting) | library | build ms | B/tri "
+          "| primary, closest | random, closest | random, any-hit | bounce, closest |")
     print("|---|---|---|---|---|---|---|---|")
     for scene in scenes:
         first = True
@@ -86,9 +96,11 @@ def main():
                 if r is None:
                     cells.append("")
                     continue
-                cells.append(f"{bold}{float(r['mrays_per_s']):.2f} ({float(r['ratio_to_embree']):.2f}){bold}")
-            print(f"| {label} | {library_name(library, some['structure'])} | {float(some['build_ms']):.1f} "
-                  f"| {float(some['build_bytes_per_triangle']):.0f} | " + " | ".join(cells) + " |")
+                speed, ratio = float(r["mrays_per_s"]), float(r["ratio_to_embree"])
+                cells.append(f"{bold}{speed:.2f} ({ratio:.2f}){bold}")
+            name = library_name(library, some["structure"])
+            build, grown = float(some["build_ms"]), float(some["build_bytes_per_triangle"])
+            print(f"| {label} | {name} | {build:.1f} | {grown:.0f} | " + " | ".join(cells) + " |")
     print()
     for scene in scenes:
         name = SCENES.get(scene, scene)
@@ -98,9 +110,11 @@ def main():
         embree = cell.get((scene, "embree", "primary", "closest"))
         parts = []
         if packets and theirs:
-            parts.append(f"packets {float(packets['mrays_per_s']) / float(theirs['mrays_per_s']):.2f} of `rtcIntersect16`")
+            ratio = float(packets["mrays_per_s"]) / float(theirs["mrays_per_s"])
+            parts.append(f"packets {ratio:.2f} of `rtcIntersect16`")
         if ours and embree:
-            parts.append(f"build {float(ours['build_ms']) / float(embree['build_ms']):.2f}x Embree's time")
+            ratio = float(ours["build_ms"]) / float(embree["build_ms"])
+            parts.append(f"build {ratio:.2f}x Embree's time")
         print(f"{name}: " + ", ".join(parts))
 
 
