@@ -36,3 +36,8 @@ pub fn advise(start: *const u8, bytes: usize) {
     #[cfg(not(target_os = "linux"))]
     let _ = (start, bytes);
 }
+
+/// [`advise`] for the whole allocation of `values`, its capacity, before it is filled.
+pub fn advise_vec<T>(values: &Vec<T>) {
+    advise(values.as_ptr() as *const u8, values.capacity() * size_of::<T>());
+}

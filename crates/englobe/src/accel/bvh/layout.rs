@@ -73,13 +73,13 @@ impl BuildTree {
         if self.nodes.is_empty() {
             return Bvh::empty();
         }
-        let mut nodes: Vec<BvhNode> = Vec::with_capacity(self.nodes.len());
-        let mut prim_indices: Vec<u32> = Vec::with_capacity(self.prims.len());
+        let mut nodes = Vec::with_capacity(self.nodes.len());
+        let mut prim_indices = Vec::with_capacity(self.prims.len());
         // Queries read both at random: on huge pages, a large tree's reads need far fewer
         // address translations (see `crate::geom::huge_pages`). Only the pages written become
         // resident, so the slots reserved beyond the nodes cost at most one huge page.
-        crate::geom::huge_pages::advise(nodes.as_ptr() as *const u8, nodes.capacity() * size_of::<BvhNode>());
-        crate::geom::huge_pages::advise(prim_indices.as_ptr() as *const u8, prim_indices.capacity() * size_of::<u32>());
+        crate::geom::huge_pages::advise_vec(&nodes);
+        crate::geom::huge_pages::advise_vec(&prim_indices);
         let mut depth = 0u32;
         // (build node, flat node whose second-child index must point here, depth of the node)
         let mut stack: Vec<(u32, Option<usize>, u32)> = vec![(self.root, None, 0)];

@@ -47,7 +47,7 @@ impl<T: Copy> Arena<T> {
         // Huge pages: a large build's runs fill hundreds of megabytes, a page fault per 4 KiB
         // otherwise (see `crate::geom::huge_pages`); a page that a run touches is resident whole,
         // so at most one huge page more than the runs fill.
-        crate::geom::huge_pages::advise(storage.as_ptr() as *const u8, capacity * std::mem::size_of::<T>());
+        crate::geom::huge_pages::advise_vec(&storage);
         Arena { base: storage.as_mut_ptr(), _storage: storage, capacity, claimed: AtomicUsize::new(0) }
     }
 

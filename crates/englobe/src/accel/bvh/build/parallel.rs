@@ -64,7 +64,7 @@ pub fn collect_indexed<T: Send>(n: usize, min_chunk: usize, f: impl Fn(usize) ->
 /// written ([`crate::geom::huge_pages`]): for the arrays that queries read at random.
 pub fn collect_indexed_huge<T: Send>(n: usize, min_chunk: usize, f: impl Fn(usize) -> T + Sync) -> Vec<T> {
     let values = Vec::with_capacity(n);
-    crate::geom::huge_pages::advise(values.as_ptr() as *const u8, n * std::mem::size_of::<T>());
+    crate::geom::huge_pages::advise_vec(&values);
     collect_indexed_into(values, n, min_chunk, f)
 }
 

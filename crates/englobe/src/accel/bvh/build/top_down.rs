@@ -52,7 +52,7 @@ impl PrimRef {
     /// The reference of primitive `index`, whose box is `bounds`.
     #[inline]
     pub fn new(bounds: &Aabb, index: u32) -> Self {
-        PrimRef { lo: bounds.min.extend(f32::from_bits(index ^ INDEX_BITS)), hi: bounds.max.extend(1.0) }
+        Self::with_spare(bounds, index, 1.0)
     }
 
     /// The reference of primitive `index` with a number of the caller's about it, `spare`, in
