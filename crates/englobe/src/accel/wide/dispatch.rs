@@ -16,6 +16,7 @@ use super::kernels::{NodeKernel, Portable};
 use super::node::{NodeRay, WideNode};
 use super::packet::{self, PacketLeaves};
 use super::packet_kernels::{PacketRays, ScalarPacket};
+use super::packet_prep::{Lanes4, PacketPrep};
 use super::traverse::{self, Leaves};
 use crate::accel::Counters;
 
@@ -177,9 +178,14 @@ pub unsafe fn any_packet_avx512<C: Counters, L: PacketLeaves<C>>(
 pub trait PacketQuery {
     /// What the query returns.
     type Output;
-    /// Runs the query. Implementations are `#[inline(always)]`, so that their body is compiled
-    /// into the copy that calls them (a closure would be compiled without its features).
-    fn run(self) -> Self::Output;
+    /// Runs the query, its rays prepared by `prep`, made for the copy's instruction set.
+    /// Implementations are `#[inline(always)]`, so that their body is compiled into the copy that
+    /// calls them (a closure would be compiled without its features).
+    ///
+    /// # Safety
+    /// As [`PacketPrep::prepare_rows`]: compiled with the preparation's target features, run on a
+    /// processor that has them.
+    unsafe fn run<P: PacketPrep>(self, prep: P) -> Self::Output;
 }
 
 /// Runs `query` compiled for `isa`, which the processor must have (see the module documentation).
@@ -187,7 +193,8 @@ pub trait PacketQuery {
 pub fn packet_query<Q: PacketQuery>(isa: Isa, query: Q) -> Q::Output {
     debug_assert!(isa.is_available());
     match isa {
-        Isa::Portable => query.run(),
+        // SAFETY: the portable preparation needs nothing beyond the target's baseline.
+        Isa::Portable => unsafe { query.run(Lanes4) },
         // SAFETY: the structure's instruction set is one the processor has (module documentation).
         #[cfg(target_arch = "x86_64")]
         Isa::Avx2 => unsafe { x86::packet_query_avx2(query) },
@@ -308,6 +315,7 @@ mod x86 {
     pub use super::super::kernels::Avx512;
     use super::super::kernels::{Avx2, Avx512Fused};
     use super::super::packet_kernels::{Avx2Packet, Avx512Packet};
+    use super::super::packet_prep::Avx512Lanes;
     use super::*;
 
     /// The fused kernel as a walk takes it, its constants made at the walk's start
@@ -318,14 +326,16 @@ mod x86 {
     /// The processor has AVX2, FMA and the bit instructions that come with them (see `Isa`).
     #[target_feature(enable = "avx2,fma,bmi1,bmi2,lzcnt,popcnt")]
     pub unsafe fn packet_query_avx2<Q: PacketQuery>(query: Q) -> Q::Output {
-        query.run()
+        // SAFETY: the portable preparation needs nothing beyond the target's baseline.
+        unsafe { query.run(Lanes4) }
     }
 
     /// # Safety
     /// The processor has AVX-512 F, VL, BW and DQ (and AVX2).
     #[target_feature(enable = "avx2,fma,bmi1,bmi2,lzcnt,popcnt,avx512f,avx512vl,avx512bw,avx512dq")]
     pub unsafe fn packet_query_avx512<Q: PacketQuery>(query: Q) -> Q::Output {
-        query.run()
+        // SAFETY: compiled with AVX-512, which the caller guarantees.
+        unsafe { query.run(Avx512Lanes) }
     }
 
     /// # Safety

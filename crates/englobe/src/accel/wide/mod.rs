@@ -53,6 +53,7 @@ pub mod output;
 pub mod packet;
 pub mod packet_interval;
 pub mod packet_kernels;
+pub(crate) mod packet_prep;
 pub mod packet_rays;
 pub mod packet_triangles;
 mod pieces;

@@ -53,6 +53,25 @@ pub(super) fn nonempty(t_min: Vec4, t_max: Vec4) -> BVec4A {
     t_min.cmple(t_max) & t_min.cmplt(Vec4::INFINITY) & t_max.cmpgt(Vec4::NEG_INFINITY)
 }
 
+/// The axes the rays in `lanes` (bit per lane) go down (bit per axis), if each axis is gone the
+/// same way by all of them, as an interval asks ([`PacketInterval`]); `None` for no lane at all.
+#[inline(always)]
+pub(super) fn interval_axes(p: &PacketRays, lanes: u32) -> Option<u32> {
+    if lanes == 0 {
+        return None;
+    }
+    // One way along each axis: the lanes' signs all set or all clear.
+    let mut down = 0;
+    for (a, &d) in p.down.iter().enumerate() {
+        match d & lanes {
+            0 => {}
+            d if d == lanes => down |= 1 << a,
+            _ => return None,
+        }
+    }
+    Some(down)
+}
+
 impl PacketRays {
     /// No ray: every row zero, no lane valid; what the makers of packets fill in.
     pub(super) const EMPTY: PacketRays = PacketRays {
@@ -151,18 +170,7 @@ impl PacketRays {
     /// no lane at all.
     #[inline(always)]
     fn interval(&self, lanes: u32) -> Option<PacketInterval> {
-        if lanes == 0 {
-            return None;
-        }
-        // One way along each axis: the lanes' signs all set or all clear.
-        let mut down = 0;
-        for (a, &d) in self.down.iter().enumerate() {
-            match d & lanes {
-                0 => {}
-                d if d == lanes => down |= 1 << a,
-                _ => return None,
-            }
-        }
+        let down = interval_axes(self, lanes)?;
         let (mut o_lo, mut o_hi) = ([Vec4::INFINITY; 3], [Vec4::NEG_INFINITY; 3]);
         let (mut inv_lo, mut inv_hi) = ([Vec4::INFINITY; 3], [Vec4::NEG_INFINITY; 3]);
         let mut t_min = Vec4::INFINITY;

@@ -14,6 +14,7 @@ use super::dispatch;
 use super::isa::Isa;
 use super::packet;
 use super::packet_kernels::{PACKET, PacketRays};
+use super::packet_prep::PacketPrep;
 use super::packet_triangles::PacketBest;
 #[cfg(target_arch = "x86_64")]
 use super::packet_triangles::{Avx2Block, Avx512Block};
@@ -125,9 +126,19 @@ impl TriangleBvh {
         }
     }
 
-    /// The closest hits of the valid rays of `among` in `packet` (the others get none).
+    /// The closest hits of the valid rays of `among` in `packet` (the others get none), the
+    /// packet bounded with `prep`.
+    ///
+    /// # Safety
+    /// As [`PacketPrep::prepare_rows`].
     #[inline(always)]
-    fn closest_of_packet<C: Counters>(&self, packet: &mut PacketRays, among: u32, counters: &mut C) -> PacketBest {
+    unsafe fn closest_of_packet<P: PacketPrep, C: Counters>(
+        &self,
+        prep: P,
+        packet: &mut PacketRays,
+        among: u32,
+        counters: &mut C,
+    ) -> PacketBest {
         let mut best = PacketBest::new(&packet.t_max);
         let among = among & packet.valid;
         if among == 0 || self.nodes().is_empty() {
@@ -143,12 +154,13 @@ impl TriangleBvh {
         }
         // The rays that pass beside the tree's box are dropped first, as a single ray is: a
         // packet none of whose rays enters costs that test and no node.
-        let limits = packet.limits();
-        let active = among & packet.may_enter(&self.bounds(), &limits);
+        // SAFETY (the three preparation steps): the caller's guarantee.
+        let limits = unsafe { prep.limits(packet) };
+        let active = among & unsafe { prep.may_enter(packet, &self.bounds(), &limits) };
         if active == 0 {
             return best;
         }
-        packet.bound(active);
+        unsafe { prep.bound(packet, active) };
         #[cfg(target_arch = "x86_64")]
         match self.isa() {
             Isa::Avx512 => {
@@ -226,9 +238,19 @@ impl TriangleBvh {
         dispatch::packet_query(self.isa(), PacketJob::<C, AnyHit>::new(self, source, among, counters))
     }
 
-    /// The valid rays of `among` in `packet` that hit something.
+    /// The valid rays of `among` in `packet` that hit something (see
+    /// [`TriangleBvh::closest_of_packet`]).
+    ///
+    /// # Safety
+    /// As [`PacketPrep::prepare_rows`].
     #[inline(always)]
-    fn any_of_packet<C: Counters>(&self, packet: &mut PacketRays, among: u32, counters: &mut C) -> u32 {
+    unsafe fn any_of_packet<P: PacketPrep, C: Counters>(
+        &self,
+        prep: P,
+        packet: &mut PacketRays,
+        among: u32,
+        counters: &mut C,
+    ) -> u32 {
         let among = among & packet.valid;
         if among == 0 || self.nodes().is_empty() {
             return 0;
@@ -240,12 +262,13 @@ impl TriangleBvh {
         }
         // The rays that pass beside the tree's box are dropped first, as a single ray is: a
         // packet none of whose rays enters costs that test and no node.
-        let limits = packet.limits();
-        let active = among & packet.may_enter(&self.bounds(), &limits);
+        // SAFETY (the three preparation steps): the caller's guarantee.
+        let limits = unsafe { prep.limits(packet) };
+        let active = among & unsafe { prep.may_enter(packet, &self.bounds(), &limits) };
         if active == 0 {
             return 0;
         }
-        packet.bound(active);
+        unsafe { prep.bound(packet, active) };
         #[cfg(target_arch = "x86_64")]
         match self.isa() {
             Isa::Avx512 => {
@@ -279,10 +302,14 @@ impl PacketSource<'_> {
     /// The rays prepared for the walk, valid only in `among`, written into `packet`, which is
     /// [`PacketRays::EMPTY`]. (In place: a packet made and then moved there was copied, a kilobyte
     /// per query, by a call to `memcpy` that waited for the stores just made.)
+    ///
+    /// # Safety
+    /// As [`PacketPrep::prepare_rows`].
     #[inline(always)]
-    fn prepare_into(self, among: u32, packet: &mut PacketRays) {
+    unsafe fn prepare_into<P: PacketPrep>(self, prep: P, among: u32, packet: &mut PacketRays) {
         match self {
-            PacketSource::Rows(rows) => rows.prepare_into(among, packet),
+            // SAFETY: the caller's guarantee.
+            PacketSource::Rows(rows) => unsafe { prep.prepare_rows(rows, among, packet) },
             // The rays' checks come with their transposition, four at a time.
             PacketSource::Slice(rays) => packet.fill(rays),
         }
@@ -315,10 +342,13 @@ impl<C: Counters> dispatch::PacketQuery for PacketJob<'_, C, ClosestHits> {
     type Output = PacketBest;
 
     #[inline(always)]
-    fn run(self) -> PacketBest {
+    unsafe fn run<P: PacketPrep>(self, prep: P) -> PacketBest {
         let mut packet = PacketRays::EMPTY;
-        self.source.prepare_into(self.among, &mut packet);
-        self.bvh.closest_of_packet(&mut packet, self.among, self.counters)
+        // SAFETY: `run`'s guarantee.
+        unsafe {
+            self.source.prepare_into(prep, self.among, &mut packet);
+            self.bvh.closest_of_packet(prep, &mut packet, self.among, self.counters)
+        }
     }
 }
 
@@ -326,9 +356,12 @@ impl<C: Counters> dispatch::PacketQuery for PacketJob<'_, C, AnyHit> {
     type Output = u32;
 
     #[inline(always)]
-    fn run(self) -> u32 {
+    unsafe fn run<P: PacketPrep>(self, prep: P) -> u32 {
         let mut packet = PacketRays::EMPTY;
-        self.source.prepare_into(self.among, &mut packet);
-        self.bvh.any_of_packet(&mut packet, self.among, self.counters)
+        // SAFETY: `run`'s guarantee.
+        unsafe {
+            self.source.prepare_into(prep, self.among, &mut packet);
+            self.bvh.any_of_packet(prep, &mut packet, self.among, self.counters)
+        }
     }
 }

@@ -1,0 +1,328 @@
+//! A packet's preparation with the instruction set of its query: the rays' rows made from the
+//! caller's ([`RayPacket`]), their limits, the test of the packet against the tree's box and the
+//! packet's interval ([`PacketInterval`]), all of it per ray before the first node.
+//!
+//! The portable preparation ([`Lanes4`]) works four lanes at a time through `glam`, which stays
+//! four lanes wide whatever the processor has: four steps and four mask moves per row of sixteen
+//! rays, and a minimum or maximum over a row of the interval in four pieces. With AVX-512 a row is
+//! one register and a comparison lands in a mask register ([`Avx512Lanes`]): about half the
+//! instructions of a packet's preparation (a plain sixteen-lane loop left to the compiler was
+//! vectorised into pieces of two and four lanes, and ran more instructions than `glam`). Either
+//! way the same operations on the same numbers, so the same bits, as the tests check lane by lane.
+
+use super::packet_interval::PacketInterval;
+use super::packet_rays::{Lanes, PacketRays};
+use super::ray_packet::RayPacket;
+use crate::Aabb;
+
+/// How a packet query prepares its rays (see the module documentation).
+pub trait PacketPrep: Copy {
+    /// The rays of `rows` prepared for the walk, valid only in `active`, written into `p` (every
+    /// field of it): [`RayPacket::prepare_into`].
+    ///
+    /// # Safety
+    /// As [`super::kernels::NodeKernel::children`]: the caller is compiled with the
+    /// preparation's target features and runs on a processor that has them.
+    unsafe fn prepare_rows(self, rows: &RayPacket, active: u32, p: &mut PacketRays);
+
+    /// How far each ray may enter a box: [`PacketRays::limits`].
+    ///
+    /// # Safety
+    /// As [`PacketPrep::prepare_rows`].
+    unsafe fn limits(self, p: &PacketRays) -> Lanes;
+
+    /// The lanes that may enter `bounds` within `t_min..=limits[i]`: [`PacketRays::may_enter`].
+    ///
+    /// # Safety
+    /// As [`PacketPrep::prepare_rows`].
+    unsafe fn may_enter(self, p: &PacketRays, bounds: &Aabb, limits: &Lanes) -> u32;
+
+    /// Adds the interval of the rays in `lanes` to `p`: [`PacketRays::bound`].
+    ///
+    /// # Safety
+    /// As [`PacketPrep::prepare_rows`].
+    unsafe fn bound(self, p: &mut PacketRays, lanes: u32);
+}
+
+/// Four lanes at a time through `glam`: every processor.
+#[derive(Clone, Copy, Debug)]
+pub struct Lanes4;
+
+impl PacketPrep for Lanes4 {
+    #[inline(always)]
+    unsafe fn prepare_rows(self, rows: &RayPacket, active: u32, p: &mut PacketRays) {
+        rows.prepare_into(active, p);
+    }
+
+    #[inline(always)]
+    unsafe fn limits(self, p: &PacketRays) -> Lanes {
+        p.limits()
+    }
+
+    #[inline(always)]
+    unsafe fn may_enter(self, p: &PacketRays, bounds: &Aabb, limits: &Lanes) -> u32 {
+        p.may_enter(bounds, limits)
+    }
+
+    #[inline(always)]
+    unsafe fn bound(self, p: &mut PacketRays, lanes: u32) {
+        p.bound(lanes);
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+pub use x86::Avx512Lanes;
+
+#[cfg(target_arch = "x86_64")]
+mod x86 {
+    use std::arch::x86_64::*;
+
+    use glam::Vec3A;
+
+    use super::super::node::FAR_SCALE;
+    use super::super::packet_rays::{PACKET, interval_axes};
+    use super::{Aabb, Lanes, PacketInterval, PacketPrep, PacketRays, RayPacket};
+    use crate::geom::aabb::ROBUST_FAR_SCALE;
+
+    /// Sixteen lanes at once with AVX-512 F.
+    #[derive(Clone, Copy, Debug)]
+    pub struct Avx512Lanes;
+
+    /// A row of sixteen floats (aligned to 64 bytes, as every row of a packet is).
+    ///
+    /// # Safety
+    /// The caller is compiled with AVX-512 F and runs on a processor that has it.
+    #[inline(always)]
+    unsafe fn load(row: &[f32; PACKET]) -> __m512 {
+        // SAFETY: the caller's guarantee; the rows of `RayPacket`, `Lanes` and `PacketRays` are
+        // 64 bytes at offsets that are multiples of 64 in structures aligned to 64.
+        unsafe { _mm512_load_ps(row.as_ptr()) }
+    }
+
+    /// Writes a row (aligned as in [`load`]).
+    ///
+    /// # Safety
+    /// As [`load`].
+    #[inline(always)]
+    unsafe fn store(row: &mut [f32; PACKET], v: __m512) {
+        // SAFETY: as in `load`.
+        unsafe { _mm512_store_ps(row.as_mut_ptr(), v) }
+    }
+
+    /// The lanes whose value is finite (`|x| < inf`, as `glam`'s `is_finite_mask`).
+    ///
+    /// # Safety
+    /// As [`load`].
+    #[inline(always)]
+    unsafe fn finite(x: __m512) -> __mmask16 {
+        // SAFETY: as in `load`.
+        unsafe { _mm512_cmp_ps_mask::<_CMP_LT_OQ>(_mm512_abs_ps(x), _mm512_set1_ps(f32::INFINITY)) }
+    }
+
+    impl PacketPrep for Avx512Lanes {
+        #[inline(always)]
+        unsafe fn prepare_rows(self, rows: &RayPacket, active: u32, p: &mut PacketRays) {
+            // SAFETY (for the whole function): the caller's guarantee, and the rows as in `load`.
+            unsafe {
+                let zero = _mm512_setzero_ps();
+                let (mut finite_lanes, mut moving) = (u16::MAX, 0);
+                for a in 0..3 {
+                    let (o, d) = (load(&rows.origin[a]), load(&rows.dir[a]));
+                    // `Ray::segment`'s inverse: `+inf` for a zero of either sign.
+                    let zero_d = _mm512_cmp_ps_mask::<_CMP_EQ_OQ>(d, zero);
+                    let inv = _mm512_mask_blend_ps(
+                        zero_d,
+                        _mm512_div_ps(_mm512_set1_ps(1.0), d),
+                        _mm512_set1_ps(f32::INFINITY),
+                    );
+                    store(&mut p.origin[a].0, o);
+                    store(&mut p.dir[a].0, d);
+                    store(&mut p.inv_dir[a].0, inv);
+                    store(&mut p.inv_far[a].0, _mm512_mul_ps(inv, _mm512_set1_ps(FAR_SCALE)));
+                    p.down[a] = _mm512_cmp_ps_mask::<_CMP_LT_OQ>(inv, zero) as u32;
+                    finite_lanes &= finite(o) & finite(d);
+                    // Unordered: a NaN component counts as moving, as `glam`'s `cmpne` has it
+                    // (the ray is not valid either way: it is not finite).
+                    moving |= _mm512_cmp_ps_mask::<_CMP_NEQ_UQ>(d, zero);
+                }
+                let (t_min, t_max) = (load(&rows.t_min), load(&rows.t_max));
+                store(&mut p.t_min.0, t_min);
+                store(&mut p.t_max.0, t_max);
+                let nonempty = _mm512_cmp_ps_mask::<_CMP_LE_OQ>(t_min, t_max)
+                    & _mm512_cmp_ps_mask::<_CMP_LT_OQ>(t_min, _mm512_set1_ps(f32::INFINITY))
+                    & _mm512_cmp_ps_mask::<_CMP_GT_OQ>(t_max, _mm512_set1_ps(f32::NEG_INFINITY));
+                p.valid = (finite_lanes & moving & nonempty) as u32 & active;
+                p.interval = None;
+            }
+        }
+
+        #[inline(always)]
+        unsafe fn limits(self, p: &PacketRays) -> Lanes {
+            // SAFETY: as in `prepare_rows`.
+            unsafe {
+                let t_max = load(&p.t_max.0);
+                // A product then a sum, as `reach` rounds them (never fused).
+                let stretch = _mm512_mul_ps(_mm512_abs_ps(t_max), _mm512_set1_ps(ROBUST_FAR_SCALE - 1.0));
+                let mut limits = Lanes([0.0; PACKET]);
+                store(&mut limits.0, _mm512_add_ps(t_max, stretch));
+                limits
+            }
+        }
+
+        #[inline(always)]
+        unsafe fn may_enter(self, p: &PacketRays, bounds: &Aabb, limits: &Lanes) -> u32 {
+            // SAFETY: as in `prepare_rows`.
+            unsafe {
+                let (mut enter, mut exit) = (load(&p.t_min.0), load(&limits.0));
+                for a in 0..3 {
+                    let (o, inv) = (load(&p.origin[a].0), load(&p.inv_dir[a].0));
+                    let lo = _mm512_sub_ps(_mm512_set1_ps(bounds.min[a]), o);
+                    let hi = _mm512_sub_ps(_mm512_set1_ps(bounds.max[a]), o);
+                    let down = _mm512_cmp_ps_mask::<_CMP_LT_OQ>(inv, _mm512_setzero_ps());
+                    let near = _mm512_mul_ps(_mm512_mask_blend_ps(down, lo, hi), inv);
+                    let far = _mm512_mul_ps(_mm512_mask_blend_ps(down, hi, lo), load(&p.inv_far[a].0));
+                    // `max(a, b)` is `a > b ? a : b`, `b` when either is NaN: a NaN distance
+                    // constrains nothing, as in the portable test.
+                    enter = _mm512_max_ps(near, enter);
+                    exit = _mm512_min_ps(far, exit);
+                }
+                _mm512_cmp_ps_mask::<_CMP_LE_OQ>(enter, exit) as u32
+            }
+        }
+
+        #[inline(always)]
+        unsafe fn bound(self, p: &mut PacketRays, lanes: u32) {
+            let Some(down) = interval_axes(p, lanes) else {
+                p.interval = None;
+                return;
+            };
+            // SAFETY: as in `prepare_rows`.
+            unsafe {
+                let k = lanes as __mmask16;
+                let mut usable = k;
+                let (mut o_lo, mut o_hi, mut inv_lo, mut inv_hi) = ([0.0; 3], [0.0; 3], [0.0; 3], [0.0; 3]);
+                for a in 0..3 {
+                    let (o, inv) = (load(&p.origin[a].0), load(&p.inv_dir[a].0));
+                    usable &= finite(o) & finite(inv) & _mm512_cmp_ps_mask::<_CMP_NEQ_UQ>(inv, _mm512_setzero_ps());
+                    // The lanes left out are passed over (taken as infinities of the right sign).
+                    (o_lo[a], o_hi[a]) = (_mm512_mask_reduce_min_ps(k, o), _mm512_mask_reduce_max_ps(k, o));
+                    (inv_lo[a], inv_hi[a]) = (_mm512_mask_reduce_min_ps(k, inv), _mm512_mask_reduce_max_ps(k, inv));
+                }
+                // Not `then` with a closure: its body would be compiled without AVX-512, and the
+                // reduction in it made a call.
+                p.interval = if usable == k {
+                    let t_min = _mm512_mask_reduce_min_ps(k, load(&p.t_min.0));
+                    Some(PacketInterval::from_bounds(
+                        down,
+                        [Vec3A::from_array(o_lo), Vec3A::from_array(o_hi)],
+                        [Vec3A::from_array(inv_lo), Vec3A::from_array(inv_hi)],
+                        t_min,
+                    ))
+                } else {
+                    None
+                };
+            }
+        }
+    }
+}
+
+#[cfg(all(test, target_arch = "x86_64"))]
+mod tests {
+    use glam::Vec3;
+    use rand::{RngExt, SeedableRng};
+    use rand_pcg::Pcg32;
+
+    use super::super::isa::Isa;
+    use super::super::packet_rays::PACKET;
+    use super::*;
+    use crate::Ray;
+
+    /// The bits of a row.
+    fn bits(l: &Lanes) -> [u32; PACKET] {
+        l.0.map(f32::to_bits)
+    }
+
+    /// Both preparations of random packets, with coordinates now and then replaced by zeros of
+    /// both signs, infinities, NaN and tiny numbers, give the same bits in every field, limit,
+    /// box test and interval.
+    #[test]
+    fn sixteen_lanes_at_once_prepare_as_four_at_a_time() {
+        if !Isa::Avx512.is_available() {
+            return;
+        }
+        let mut rng = Pcg32::seed_from_u64(0x16_1a4e5);
+        let odd = [0.0f32, -0.0, f32::INFINITY, f32::NEG_INFINITY, f32::NAN, 1e-40, -3.5];
+        let (mut valid, mut entered, mut intervals) = (0, 0, 0);
+        for round in 0..3_000 {
+            let mut rows = RayPacket::default();
+            // Every fourth packet a camera's: one direction sign per axis, so that it has an
+            // interval; the others anything.
+            let camera = round % 4 == 0;
+            for lane in 0..PACKET {
+                let mut r = [0.0f32; 6];
+                for x in &mut r {
+                    *x = rng.random_range(-1.0..1.0);
+                }
+                let mut v = |x: f32| {
+                    if !camera && rng.random_range(0..6) == 0 { odd[rng.random_range(0..odd.len())] } else { x }
+                };
+                let o = Vec3::new(v(2.0 * r[0]), v(0.5), v(r[1]));
+                let d = Vec3::new(v(0.1 + r[2].abs()), v(-1.0), v(r[3]));
+                let d = if camera { d.abs() * Vec3::new(1.0, -1.0, 1.0) } else { d };
+                let (t_min, t_max) = (v(0.0), v(10.0 + 9.0 * r[4]));
+                rows.set(lane, o, d, t_min, t_max);
+            }
+            let active = rng.random_range(0..=u16::MAX as u32);
+            // Into packets that hold other rays, an interval included: every field is written.
+            let other = PacketRays::new(&[Ray::new(Vec3::splat(3.0), Vec3::new(-1.0, -2.0, -0.5)); PACKET]);
+            let (mut four, mut sixteen) = (other, other);
+            sixteen.bound(u32::MAX >> (32 - PACKET));
+            assert!(sixteen.interval.is_some());
+            // SAFETY: AVX-512 is available (checked above); the portable one needs nothing.
+            unsafe {
+                Lanes4.prepare_rows(&rows, active, &mut four);
+                Avx512Lanes.prepare_rows(&rows, active, &mut sixteen);
+            }
+            for a in 0..3 {
+                assert_eq!(bits(&four.origin[a]), bits(&sixteen.origin[a]));
+                assert_eq!(bits(&four.dir[a]), bits(&sixteen.dir[a]));
+                assert_eq!(bits(&four.inv_dir[a]), bits(&sixteen.inv_dir[a]), "{rows:?}");
+                assert_eq!(bits(&four.inv_far[a]), bits(&sixteen.inv_far[a]));
+                assert_eq!(four.down[a], sixteen.down[a]);
+            }
+            assert_eq!((bits(&four.t_min), bits(&four.t_max)), (bits(&sixteen.t_min), bits(&sixteen.t_max)));
+            assert_eq!(four.valid, sixteen.valid, "{rows:?}");
+            assert_eq!(sixteen.interval, None);
+            valid += four.valid.count_ones();
+
+            // SAFETY: as above.
+            let (limits, limits16) = unsafe { (Lanes4.limits(&four), Avx512Lanes.limits(&four)) };
+            assert_eq!(bits(&limits), bits(&limits16));
+            let (a, b) = (
+                Vec3::new(rng.random_range(-3.0..1.0), rng.random_range(-3.0..0.0), rng.random_range(-2.0..1.0)),
+                Vec3::new(rng.random_range(1.0..4.0), rng.random_range(-1.0..2.0), rng.random_range(0.0..3.0)),
+            );
+            // Now and then a flat box, or one whose planes the origins lie on.
+            let bounds = match round % 5 {
+                0 => Aabb::new(a, Vec3::new(b.x, a.y, b.z)),
+                1 => Aabb::new(Vec3::new(-2.0, 0.5, a.z), b),
+                _ => Aabb::new(a, b),
+            };
+            // SAFETY: as above.
+            let mask = unsafe { Lanes4.may_enter(&four, &bounds, &limits) };
+            assert_eq!(mask, unsafe { Avx512Lanes.may_enter(&four, &bounds, &limits) }, "{rows:?}, {bounds:?}");
+            entered += (mask & four.valid).count_ones();
+
+            let lanes = four.valid & rng.random_range(0..=u16::MAX as u32);
+            let mut bounded = four;
+            // SAFETY: as above.
+            unsafe {
+                Lanes4.bound(&mut four, lanes);
+                Avx512Lanes.bound(&mut bounded, lanes);
+            }
+            assert_eq!(four.interval, bounded.interval, "lanes {lanes:b} of {rows:?}");
+            intervals += four.interval.is_some() as u32;
+        }
+        assert!(valid > 10_000 && entered > 5_000 && intervals > 300, "{valid}, {entered}, {intervals}");
+    }
+}
