@@ -315,7 +315,7 @@ mod x86 {
     pub use super::super::kernels::Avx512;
     use super::super::kernels::{Avx2, Avx512Fused};
     use super::super::packet_kernels::{Avx2Packet, Avx512Packet};
-    use super::super::packet_prep::Avx512Lanes;
+    use super::super::packet_prep::{Avx2Lanes, Avx512Lanes};
     use super::*;
 
     /// The fused kernel as a walk takes it, its constants made at the walk's start
@@ -326,8 +326,8 @@ mod x86 {
     /// The processor has AVX2, FMA and the bit instructions that come with them (see `Isa`).
     #[target_feature(enable = "avx2,fma,bmi1,bmi2,lzcnt,popcnt")]
     pub unsafe fn packet_query_avx2<Q: PacketQuery>(query: Q) -> Q::Output {
-        // SAFETY: the portable preparation needs nothing beyond the target's baseline.
-        unsafe { query.run(Lanes4) }
+        // SAFETY: compiled with AVX2, which the caller guarantees.
+        unsafe { query.run(Avx2Lanes) }
     }
 
     /// # Safety

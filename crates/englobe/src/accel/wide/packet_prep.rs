@@ -5,10 +5,11 @@
 //! The portable preparation ([`Lanes4`]) works four lanes at a time through `glam`, which stays
 //! four lanes wide whatever the processor has: four steps and four mask moves per row of sixteen
 //! rays, and a minimum or maximum over a row of the interval in four pieces. With AVX-512 a row is
-//! one register and a comparison lands in a mask register ([`Avx512Lanes`]): about half the
-//! instructions of a packet's preparation (a plain sixteen-lane loop left to the compiler was
-//! vectorised into pieces of two and four lanes, and ran more instructions than `glam`). Either
-//! way the same operations on the same numbers, so the same bits, as the tests check lane by lane.
+//! one register and a comparison lands in a mask register ([`Avx512Lanes`]); with AVX2 a row is
+//! two, and a comparison's lanes become bits with one move per half ([`Avx2Lanes`]). (A plain
+//! sixteen-lane loop left to the compiler was vectorised into pieces of two and four lanes, and
+//! ran more instructions than `glam` in the AVX-512 copy.) Every way the same operations on the
+//! same numbers, so the same bits, as the tests check lane by lane.
 
 use super::packet_interval::PacketInterval;
 use super::packet_rays::{Lanes, PacketRays};
@@ -71,7 +72,7 @@ impl PacketPrep for Lanes4 {
 }
 
 #[cfg(target_arch = "x86_64")]
-pub use x86::Avx512Lanes;
+pub use x86::{Avx2Lanes, Avx512Lanes};
 
 #[cfg(target_arch = "x86_64")]
 mod x86 {
@@ -224,6 +225,235 @@ mod x86 {
             }
         }
     }
+
+    /// Sixteen lanes in two halves of eight with AVX2 (and FMA's processors' AVX): comparisons
+    /// into lane masks, moved into bits half by half.
+    #[derive(Clone, Copy, Debug)]
+    pub struct Avx2Lanes;
+
+    /// Lanes of one half of a row.
+    const HALF: usize = PACKET / 2;
+
+    /// Half `h` of a row (aligned to 32 bytes: a 64-aligned row's first or second half).
+    ///
+    /// # Safety
+    /// The caller is compiled with AVX and runs on a processor that has it.
+    #[inline(always)]
+    unsafe fn load8(row: &[f32; PACKET], h: usize) -> __m256 {
+        // SAFETY: the caller's guarantee; `h` is 0 or 1 at every call, so the eight floats lie in
+        // the row, at an offset of 0 or 32 bytes from its 64-aligned start.
+        unsafe { _mm256_load_ps(row.as_ptr().add(HALF * h)) }
+    }
+
+    /// Writes half `h` of a row (aligned as in [`load8`]).
+    ///
+    /// # Safety
+    /// As [`load8`].
+    #[inline(always)]
+    unsafe fn store8(row: &mut [f32; PACKET], h: usize, v: __m256) {
+        // SAFETY: as in `load8`.
+        unsafe { _mm256_store_ps(row.as_mut_ptr().add(HALF * h), v) }
+    }
+
+    /// The bits of the lanes a comparison set, in place for half `h`.
+    ///
+    /// # Safety
+    /// As [`load8`].
+    #[inline(always)]
+    unsafe fn bits8(compared: __m256, h: usize) -> u32 {
+        // SAFETY: as in `load8`.
+        (unsafe { _mm256_movemask_ps(compared) } as u32) << (HALF * h)
+    }
+
+    /// The lanes of half `h` whose value is finite, as bits in place.
+    ///
+    /// # Safety
+    /// As [`load8`].
+    #[inline(always)]
+    unsafe fn finite8(x: __m256, h: usize) -> u32 {
+        // SAFETY: as in `load8`.
+        unsafe {
+            let magnitude = _mm256_andnot_ps(_mm256_set1_ps(-0.0), x);
+            bits8(_mm256_cmp_ps::<_CMP_LT_OQ>(magnitude, _mm256_set1_ps(f32::INFINITY)), h)
+        }
+    }
+
+    /// All ones in the lanes of half `h` whose bit is set in `lanes`.
+    ///
+    /// # Safety
+    /// As [`load8`].
+    #[inline(always)]
+    unsafe fn taken8(lanes: u32, h: usize) -> __m256 {
+        // SAFETY: as in `load8`.
+        unsafe {
+            let each = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
+            let bits = _mm256_and_si256(_mm256_set1_epi32((lanes >> (HALF * h)) as i32), each);
+            _mm256_castsi256_ps(_mm256_cmpeq_epi32(bits, each))
+        }
+    }
+
+    /// `min` if `LEAST`, else `max` (`b` when either is NaN; the values here never are).
+    ///
+    /// # Safety
+    /// As [`load8`].
+    #[inline(always)]
+    unsafe fn pick8<const LEAST: bool>(a: __m256, b: __m256) -> __m256 {
+        // SAFETY: as in `load8`.
+        unsafe { if LEAST { _mm256_min_ps(a, b) } else { _mm256_max_ps(a, b) } }
+    }
+
+    /// The least (`LEAST`) or the greatest of the lanes of `row` in `lanes`, the others passed
+    /// over (taken as the infinity that loses). No closures: their bodies would be compiled
+    /// without AVX, and every intrinsic in them made a call.
+    ///
+    /// # Safety
+    /// As [`load8`].
+    #[inline(always)]
+    unsafe fn extreme8<const LEAST: bool>(row: &[f32; PACKET], lanes: u32) -> f32 {
+        // SAFETY: as in `load8`.
+        unsafe {
+            let neutral = _mm256_set1_ps(if LEAST { f32::INFINITY } else { f32::NEG_INFINITY });
+            let low = _mm256_blendv_ps(neutral, load8(row, 0), taken8(lanes, 0));
+            let high = _mm256_blendv_ps(neutral, load8(row, 1), taken8(lanes, 1));
+            let v = pick8::<LEAST>(low, high);
+            let v = pick8::<LEAST>(v, _mm256_permute2f128_ps::<1>(v, v));
+            let v = pick8::<LEAST>(v, _mm256_permute_ps::<0b01_00_11_10>(v));
+            let v = pick8::<LEAST>(v, _mm256_permute_ps::<0b10_11_00_01>(v));
+            _mm256_cvtss_f32(v)
+        }
+    }
+
+    /// [`extreme8`] of each of the three `rows`.
+    ///
+    /// # Safety
+    /// As [`load8`].
+    #[inline(always)]
+    unsafe fn extremes8<const LEAST: bool>(rows: &[Lanes; 3], lanes: u32) -> Vec3A {
+        // SAFETY: as in `load8`.
+        unsafe {
+            Vec3A::new(
+                extreme8::<LEAST>(&rows[0].0, lanes),
+                extreme8::<LEAST>(&rows[1].0, lanes),
+                extreme8::<LEAST>(&rows[2].0, lanes),
+            )
+        }
+    }
+
+    impl PacketPrep for Avx2Lanes {
+        #[inline(always)]
+        unsafe fn prepare_rows(self, rows: &RayPacket, active: u32, p: &mut PacketRays) {
+            // SAFETY (for the whole function): the caller's guarantee, and the rows as in `load8`.
+            unsafe {
+                let (zero, inf) = (_mm256_setzero_ps(), _mm256_set1_ps(f32::INFINITY));
+                p.down = [0; 3];
+                p.valid = 0;
+                for h in 0..2 {
+                    let (mut finite_lanes, mut moving) = (u32::MAX, 0);
+                    for a in 0..3 {
+                        let (o, d) = (load8(&rows.origin[a], h), load8(&rows.dir[a], h));
+                        // `Ray::segment`'s inverse: `+inf` for a zero of either sign.
+                        let zero_d = _mm256_cmp_ps::<_CMP_EQ_OQ>(d, zero);
+                        let inv = _mm256_blendv_ps(_mm256_div_ps(_mm256_set1_ps(1.0), d), inf, zero_d);
+                        store8(&mut p.origin[a].0, h, o);
+                        store8(&mut p.dir[a].0, h, d);
+                        store8(&mut p.inv_dir[a].0, h, inv);
+                        store8(&mut p.inv_far[a].0, h, _mm256_mul_ps(inv, _mm256_set1_ps(FAR_SCALE)));
+                        p.down[a] |= bits8(_mm256_cmp_ps::<_CMP_LT_OQ>(inv, zero), h);
+                        finite_lanes &= finite8(o, h) & finite8(d, h);
+                        // Unordered, as in the AVX-512 preparation.
+                        moving |= bits8(_mm256_cmp_ps::<_CMP_NEQ_UQ>(d, zero), h);
+                    }
+                    let (t_min, t_max) = (load8(&rows.t_min, h), load8(&rows.t_max, h));
+                    store8(&mut p.t_min.0, h, t_min);
+                    store8(&mut p.t_max.0, h, t_max);
+                    let nonempty = _mm256_and_ps(
+                        _mm256_cmp_ps::<_CMP_LE_OQ>(t_min, t_max),
+                        _mm256_and_ps(
+                            _mm256_cmp_ps::<_CMP_LT_OQ>(t_min, inf),
+                            _mm256_cmp_ps::<_CMP_GT_OQ>(t_max, _mm256_set1_ps(f32::NEG_INFINITY)),
+                        ),
+                    );
+                    p.valid |= finite_lanes & moving & bits8(nonempty, h);
+                }
+                p.valid &= active;
+                p.interval = None;
+            }
+        }
+
+        #[inline(always)]
+        unsafe fn limits(self, p: &PacketRays) -> Lanes {
+            // SAFETY: as in `prepare_rows`.
+            unsafe {
+                let mut limits = Lanes([0.0; PACKET]);
+                for h in 0..2 {
+                    let t_max = load8(&p.t_max.0, h);
+                    let magnitude = _mm256_andnot_ps(_mm256_set1_ps(-0.0), t_max);
+                    // A product then a sum, as `reach` rounds them (never fused).
+                    let stretch = _mm256_mul_ps(magnitude, _mm256_set1_ps(ROBUST_FAR_SCALE - 1.0));
+                    store8(&mut limits.0, h, _mm256_add_ps(t_max, stretch));
+                }
+                limits
+            }
+        }
+
+        #[inline(always)]
+        unsafe fn may_enter(self, p: &PacketRays, bounds: &Aabb, limits: &Lanes) -> u32 {
+            // SAFETY: as in `prepare_rows`.
+            unsafe {
+                let mut mask = 0;
+                for h in 0..2 {
+                    let (mut enter, mut exit) = (load8(&p.t_min.0, h), load8(&limits.0, h));
+                    for a in 0..3 {
+                        let (o, inv) = (load8(&p.origin[a].0, h), load8(&p.inv_dir[a].0, h));
+                        let lo = _mm256_sub_ps(_mm256_set1_ps(bounds.min[a]), o);
+                        let hi = _mm256_sub_ps(_mm256_set1_ps(bounds.max[a]), o);
+                        let down = _mm256_cmp_ps::<_CMP_LT_OQ>(inv, _mm256_setzero_ps());
+                        let near = _mm256_mul_ps(_mm256_blendv_ps(lo, hi, down), inv);
+                        let far = _mm256_mul_ps(_mm256_blendv_ps(hi, lo, down), load8(&p.inv_far[a].0, h));
+                        // As in the AVX-512 test: a NaN distance constrains nothing.
+                        enter = _mm256_max_ps(near, enter);
+                        exit = _mm256_min_ps(far, exit);
+                    }
+                    mask |= bits8(_mm256_cmp_ps::<_CMP_LE_OQ>(enter, exit), h);
+                }
+                mask
+            }
+        }
+
+        #[inline(always)]
+        unsafe fn bound(self, p: &mut PacketRays, lanes: u32) {
+            let Some(down) = interval_axes(p, lanes) else {
+                p.interval = None;
+                return;
+            };
+            // SAFETY: as in `prepare_rows`.
+            unsafe {
+                let mut usable = 0;
+                for h in 0..2 {
+                    // Each half's bits in place, the other half's clear.
+                    let mut half = u32::MAX;
+                    for a in 0..3 {
+                        let (o, inv) = (load8(&p.origin[a].0, h), load8(&p.inv_dir[a].0, h));
+                        let nonzero = _mm256_cmp_ps::<_CMP_NEQ_UQ>(inv, _mm256_setzero_ps());
+                        half &= finite8(o, h) & finite8(inv, h) & bits8(nonzero, h);
+                    }
+                    usable |= half;
+                }
+                if usable & lanes != lanes {
+                    p.interval = None;
+                    return;
+                }
+                let (o, inv) = (&p.origin, &p.inv_dir);
+                let interval = PacketInterval::from_bounds(
+                    down,
+                    [extremes8::<true>(o, lanes), extremes8::<false>(o, lanes)],
+                    [extremes8::<true>(inv, lanes), extremes8::<false>(inv, lanes)],
+                    extreme8::<true>(&p.t_min.0, lanes),
+                );
+                p.interval = Some(interval);
+            }
+        }
+    }
 }
 
 #[cfg(all(test, target_arch = "x86_64"))]
@@ -247,9 +477,16 @@ mod tests {
     /// box test and interval.
     #[test]
     fn sixteen_lanes_at_once_prepare_as_four_at_a_time() {
-        if !Isa::Avx512.is_available() {
-            return;
+        if Isa::Avx512.is_available() {
+            agree_with_four_lanes(Avx512Lanes);
         }
+        if Isa::Avx2.is_available() {
+            agree_with_four_lanes(Avx2Lanes);
+        }
+    }
+
+    /// `prep` against the four-lane preparation (its instruction set available).
+    fn agree_with_four_lanes(prep: impl PacketPrep + std::fmt::Debug) {
         let mut rng = Pcg32::seed_from_u64(0x16_1a4e5);
         let odd = [0.0f32, -0.0, f32::INFINITY, f32::NEG_INFINITY, f32::NAN, 1e-40, -3.5];
         let (mut valid, mut entered, mut intervals) = (0, 0, 0);
@@ -278,10 +515,11 @@ mod tests {
             let (mut four, mut sixteen) = (other, other);
             sixteen.bound(u32::MAX >> (32 - PACKET));
             assert!(sixteen.interval.is_some());
-            // SAFETY: AVX-512 is available (checked above); the portable one needs nothing.
+            // SAFETY: `prep`'s instruction set is available (the caller checks); the portable one
+            // needs nothing.
             unsafe {
                 Lanes4.prepare_rows(&rows, active, &mut four);
-                Avx512Lanes.prepare_rows(&rows, active, &mut sixteen);
+                prep.prepare_rows(&rows, active, &mut sixteen);
             }
             for a in 0..3 {
                 assert_eq!(bits(&four.origin[a]), bits(&sixteen.origin[a]));
@@ -296,7 +534,7 @@ mod tests {
             valid += four.valid.count_ones();
 
             // SAFETY: as above.
-            let (limits, limits16) = unsafe { (Lanes4.limits(&four), Avx512Lanes.limits(&four)) };
+            let (limits, limits16) = unsafe { (Lanes4.limits(&four), prep.limits(&four)) };
             assert_eq!(bits(&limits), bits(&limits16));
             let (a, b) = (
                 Vec3::new(rng.random_range(-3.0..1.0), rng.random_range(-3.0..0.0), rng.random_range(-2.0..1.0)),
@@ -310,7 +548,7 @@ mod tests {
             };
             // SAFETY: as above.
             let mask = unsafe { Lanes4.may_enter(&four, &bounds, &limits) };
-            assert_eq!(mask, unsafe { Avx512Lanes.may_enter(&four, &bounds, &limits) }, "{rows:?}, {bounds:?}");
+            assert_eq!(mask, unsafe { prep.may_enter(&four, &bounds, &limits) }, "{prep:?}: {rows:?}, {bounds:?}");
             entered += (mask & four.valid).count_ones();
 
             let lanes = four.valid & rng.random_range(0..=u16::MAX as u32);
@@ -318,7 +556,7 @@ mod tests {
             // SAFETY: as above.
             unsafe {
                 Lanes4.bound(&mut four, lanes);
-                Avx512Lanes.bound(&mut bounded, lanes);
+                prep.bound(&mut bounded, lanes);
             }
             assert_eq!(four.interval, bounded.interval, "lanes {lanes:b} of {rows:?}");
             intervals += four.interval.is_some() as u32;
