@@ -121,8 +121,22 @@ pub struct BuildCost {
     /// How much the process's resident memory grew across the first build, the built structure
     /// alive at the end, in bytes (`None` where the system does not say): what the structure
     /// and whatever the build left mapped cost in memory, measured the same way for every
-    /// library.
+    /// library, after [`release_free_memory`].
     pub resident_bytes: Option<u64>,
+}
+
+/// Gives the memory the allocator holds free back to the system (glibc's `malloc_trim(0)`, which
+/// also releases the free pages inside its heaps; nothing elsewhere). A build measured after it
+/// faults in every page it uses, where it would otherwise reuse the pages that loading the scene,
+/// the brute force and the libraries built before it left free and resident, and read as
+/// costing little or nothing: what a library measured later in the run would owe to the ones
+/// before it.
+pub fn release_free_memory() {
+    #[cfg(all(target_os = "linux", target_env = "gnu"))]
+    // SAFETY: `malloc_trim` takes no pointer and only releases memory no allocation holds.
+    unsafe {
+        libc::malloc_trim(0);
+    }
 }
 
 /// The process's resident memory in bytes, from Linux's `/proc/self/status` (`None` elsewhere).
@@ -139,8 +153,9 @@ fn parse_resident(status: &str) -> Option<u64> {
 }
 
 /// Runs `build` once untimed (a warm-up: thread pools started, pages mapped; the growth of the
-/// resident memory across it is measured), then `reps` times timed, on `pool`; returns the last
-/// result with the median time. Each build but the last is dropped before the next starts.
+/// resident memory across it is measured, the allocator's free memory given back first), then
+/// `reps` times timed, on `pool`; returns the last result with the median time. Each build but
+/// the last is dropped before the next starts.
 pub fn time_build<T>(
     pool: &rayon::ThreadPool,
     reps: usize,
@@ -151,6 +166,7 @@ where
 {
     pool.install(|| {
         let mut times = Vec::with_capacity(reps.max(1));
+        release_free_memory();
         let before = resident_bytes();
         let mut last = Some(build()?);
         let resident = resident_bytes().zip(before).map(|(after, before)| after.saturating_sub(before));
@@ -179,6 +195,26 @@ mod tests {
         if cfg!(target_os = "linux") {
             assert!(resident_bytes().is_some_and(|b| b > 0));
         }
+    }
+
+    /// Memory freed before a build and kept by the allocator does not hide the build's own: the
+    /// growth across it counts the pages it fills again.
+    #[test]
+    #[cfg(all(target_os = "linux", target_env = "gnu"))]
+    fn a_build_after_freed_memory_still_shows_its_pages() {
+        const PIECE: usize = 64 << 10;
+        // 64 MiB in pieces below glibc's threshold for separate mappings, then a fence above
+        // them, so that freeing them leaves free pages inside the heap rather than at its top.
+        let pieces: Vec<Vec<u8>> = (0..1024).map(|_| vec![1u8; PIECE]).collect();
+        let fence = vec![1u8; 4096];
+        drop(pieces);
+        release_free_memory();
+        let before = resident_bytes().expect("Linux says");
+        // 32 MiB filled: the free pieces' places, given back and now faulted in again.
+        let again: Vec<Vec<u8>> = (0..512).map(|_| vec![1u8; PIECE]).collect();
+        let grown = resident_bytes().expect("Linux says").saturating_sub(before);
+        assert!(grown >= 24 << 20, "grew by {grown} bytes");
+        assert_eq!(again.iter().map(|p| p[PIECE - 1] as usize).sum::<usize>() + fence[0] as usize, 513);
     }
 
     #[test]
