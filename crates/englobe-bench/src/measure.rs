@@ -214,7 +214,8 @@ mod tests {
         let again: Vec<Vec<u8>> = (0..512).map(|_| vec![1u8; PIECE]).collect();
         let grown = resident_bytes().expect("Linux says").saturating_sub(before);
         assert!(grown >= 24 << 20, "grew by {grown} bytes");
-        assert_eq!(again.iter().map(|p| p[PIECE - 1] as usize).sum::<usize>() + fence[0] as usize, 513);
+        // Both alive up to the measurement.
+        std::hint::black_box((&again, &fence));
     }
 
     #[test]
