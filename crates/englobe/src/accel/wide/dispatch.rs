@@ -314,7 +314,8 @@ mod x86 {
     use super::super::fused::FusedPlanes;
     pub use super::super::kernels::Avx512;
     use super::super::kernels::{Avx2, Avx512Fused};
-    use super::super::packet_kernels::{Avx2Packet, Avx512Packet};
+    use super::super::packet_fused::{Avx512FusedPacket, PacketPlanes};
+    use super::super::packet_kernels::{Avx2Packet, Avx512Packet, PacketKernel};
     use super::super::packet_prep::{Avx2Lanes, Avx512Lanes};
     use super::*;
 
@@ -447,7 +448,14 @@ mod x86 {
         counters: &mut C,
     ) {
         // SAFETY: compiled with AVX-512, which the caller guarantees.
-        unsafe { packet::closest(Avx512Packet, nodes, rays, active, leaves, counters) }
+        unsafe {
+            match PacketPlanes::new_avx512(rays, active) {
+                Some(planes) => {
+                    packet_walk_avx512(Avx512FusedPacket(&planes), nodes, rays, active, leaves, counters, true)
+                }
+                None => packet_walk_avx512(Avx512Packet, nodes, rays, active, leaves, counters, true),
+            };
+        }
     }
 
     /// # Safety
@@ -475,6 +483,40 @@ mod x86 {
         counters: &mut C,
     ) -> u32 {
         // SAFETY: compiled with AVX-512, which the caller guarantees.
-        unsafe { packet::any(Avx512Packet, nodes, rays, active, leaves, counters) }
+        unsafe {
+            match PacketPlanes::new_avx512(rays, active) {
+                Some(planes) => {
+                    packet_walk_avx512(Avx512FusedPacket(&planes), nodes, rays, active, leaves, counters, false)
+                }
+                None => packet_walk_avx512(Avx512Packet, nodes, rays, active, leaves, counters, false),
+            }
+        }
+    }
+
+    /// The packet walk for the closest hits (`closest`, returning 0) or for any hit (returning
+    /// the rays that hit) with `kernel`: the fused packet kernel or [`Avx512Packet`]. (Generic,
+    /// so that each kernel's walk is a function of its own, with its own registers.)
+    ///
+    /// # Safety
+    /// As [`closest_packet_avx512`]; a fused `kernel` holds the constants of the rays of `active`.
+    #[target_feature(enable = "avx2,fma,bmi1,bmi2,lzcnt,popcnt,avx512f,avx512vl,avx512bw,avx512dq")]
+    unsafe fn packet_walk_avx512<K: PacketKernel, C: Counters, L: PacketLeaves<C>>(
+        kernel: K,
+        nodes: &[WideNode],
+        rays: &PacketRays,
+        active: u32,
+        leaves: &mut L,
+        counters: &mut C,
+        closest: bool,
+    ) -> u32 {
+        // SAFETY: compiled with AVX-512, which the caller guarantees.
+        unsafe {
+            if closest {
+                packet::closest(kernel, nodes, rays, active, leaves, counters);
+                0
+            } else {
+                packet::any(kernel, nodes, rays, active, leaves, counters)
+            }
+        }
     }
 }
