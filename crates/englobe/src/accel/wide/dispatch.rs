@@ -450,10 +450,15 @@ mod x86 {
         // SAFETY: compiled with AVX-512, which the caller guarantees.
         unsafe {
             match PacketPlanes::new_avx512(rays, active) {
-                Some(planes) => {
-                    packet_walk_avx512(Avx512FusedPacket(&planes), nodes, rays, active, leaves, counters, true)
-                }
-                None => packet_walk_avx512(Avx512Packet, nodes, rays, active, leaves, counters, true),
+                Some(planes) => packet_walk_avx512::<_, _, _, true>(
+                    Avx512FusedPacket(&planes),
+                    nodes,
+                    rays,
+                    active,
+                    leaves,
+                    counters,
+                ),
+                None => packet_walk_avx512::<_, _, _, true>(Avx512Packet, nodes, rays, active, leaves, counters),
             };
         }
     }
@@ -485,33 +490,37 @@ mod x86 {
         // SAFETY: compiled with AVX-512, which the caller guarantees.
         unsafe {
             match PacketPlanes::new_avx512(rays, active) {
-                Some(planes) => {
-                    packet_walk_avx512(Avx512FusedPacket(&planes), nodes, rays, active, leaves, counters, false)
-                }
-                None => packet_walk_avx512(Avx512Packet, nodes, rays, active, leaves, counters, false),
+                Some(planes) => packet_walk_avx512::<_, _, _, false>(
+                    Avx512FusedPacket(&planes),
+                    nodes,
+                    rays,
+                    active,
+                    leaves,
+                    counters,
+                ),
+                None => packet_walk_avx512::<_, _, _, false>(Avx512Packet, nodes, rays, active, leaves, counters),
             }
         }
     }
 
-    /// The packet walk for the closest hits (`closest`, returning 0) or for any hit (returning
+    /// The packet walk for the closest hits (`CLOSEST`, returning 0) or for any hit (returning
     /// the rays that hit) with `kernel`: the fused packet kernel or [`Avx512Packet`]. (Generic,
     /// so that each kernel's walk is a function of its own, with its own registers.)
     ///
     /// # Safety
     /// As [`closest_packet_avx512`]; a fused `kernel` holds the constants of the rays of `active`.
     #[target_feature(enable = "avx2,fma,bmi1,bmi2,lzcnt,popcnt,avx512f,avx512vl,avx512bw,avx512dq")]
-    unsafe fn packet_walk_avx512<K: PacketKernel, C: Counters, L: PacketLeaves<C>>(
+    unsafe fn packet_walk_avx512<K: PacketKernel, C: Counters, L: PacketLeaves<C>, const CLOSEST: bool>(
         kernel: K,
         nodes: &[WideNode],
         rays: &PacketRays,
         active: u32,
         leaves: &mut L,
         counters: &mut C,
-        closest: bool,
     ) -> u32 {
         // SAFETY: compiled with AVX-512, which the caller guarantees.
         unsafe {
-            if closest {
+            if CLOSEST {
                 packet::closest(kernel, nodes, rays, active, leaves, counters);
                 0
             } else {

@@ -217,10 +217,11 @@ mod x86 {
         // SAFETY: the caller's guarantee.
         unsafe {
             match rows {
-                Some(rows) => (
-                    _mm512_set1_ps(node.bounds[2 * a + rows[a]][c]),
-                    _mm512_set1_ps(node.bounds[2 * a + 1 - rows[a]][c]),
-                ),
+                Some(rows) => {
+                    // `& 1`: a row within the axis's two, with no bounds check.
+                    let near = rows[a] & 1;
+                    (_mm512_set1_ps(node.bounds[2 * a + near][c]), _mm512_set1_ps(node.bounds[2 * a + 1 - near][c]))
+                }
                 None => {
                     let (lo, hi) = (_mm512_set1_ps(node.bounds[2 * a][c]), _mm512_set1_ps(node.bounds[2 * a + 1][c]));
                     // The lanes going down take the upper plane as the near one.
