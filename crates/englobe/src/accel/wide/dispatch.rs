@@ -449,7 +449,7 @@ mod x86 {
     ) {
         // SAFETY: compiled with AVX-512, which the caller guarantees.
         unsafe {
-            match PacketPlanes::new_avx512(rays, active) {
+            match None::<PacketPlanes> {
                 Some(planes) => packet_walk_avx512::<_, _, _, true>(
                     Avx512FusedPacket(&planes),
                     nodes,
@@ -489,7 +489,7 @@ mod x86 {
     ) -> u32 {
         // SAFETY: compiled with AVX-512, which the caller guarantees.
         unsafe {
-            match PacketPlanes::new_avx512(rays, active) {
+            match None::<PacketPlanes> {
                 Some(planes) => packet_walk_avx512::<_, _, _, false>(
                     Avx512FusedPacket(&planes),
                     nodes,
