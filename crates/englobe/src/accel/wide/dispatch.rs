@@ -314,8 +314,7 @@ mod x86 {
     use super::super::fused::FusedPlanes;
     pub use super::super::kernels::Avx512;
     use super::super::kernels::{Avx2, Avx512Fused};
-    use super::super::packet_fused::{Avx512FusedPacket, PacketPlanes};
-    use super::super::packet_kernels::{Avx2Packet, Avx512Packet, PacketKernel};
+    use super::super::packet_kernels::{Avx2Packet, Avx512Packet};
     use super::super::packet_prep::{Avx2Lanes, Avx512Lanes};
     use super::*;
 
@@ -448,19 +447,7 @@ mod x86 {
         counters: &mut C,
     ) {
         // SAFETY: compiled with AVX-512, which the caller guarantees.
-        unsafe {
-            match None::<PacketPlanes> {
-                Some(planes) => packet_walk_avx512::<_, _, _, true>(
-                    Avx512FusedPacket(&planes),
-                    nodes,
-                    rays,
-                    active,
-                    leaves,
-                    counters,
-                ),
-                None => packet_walk_avx512::<_, _, _, true>(Avx512Packet, nodes, rays, active, leaves, counters),
-            };
-        }
+        unsafe { packet::closest(Avx512Packet, nodes, rays, active, leaves, counters) }
     }
 
     /// # Safety
@@ -488,44 +475,6 @@ mod x86 {
         counters: &mut C,
     ) -> u32 {
         // SAFETY: compiled with AVX-512, which the caller guarantees.
-        unsafe {
-            match None::<PacketPlanes> {
-                Some(planes) => packet_walk_avx512::<_, _, _, false>(
-                    Avx512FusedPacket(&planes),
-                    nodes,
-                    rays,
-                    active,
-                    leaves,
-                    counters,
-                ),
-                None => packet_walk_avx512::<_, _, _, false>(Avx512Packet, nodes, rays, active, leaves, counters),
-            }
-        }
-    }
-
-    /// The packet walk for the closest hits (`CLOSEST`, returning 0) or for any hit (returning
-    /// the rays that hit) with `kernel`: the fused packet kernel or [`Avx512Packet`]. (Generic,
-    /// so that each kernel's walk is a function of its own, with its own registers.)
-    ///
-    /// # Safety
-    /// As [`closest_packet_avx512`]; a fused `kernel` holds the constants of the rays of `active`.
-    #[target_feature(enable = "avx2,fma,bmi1,bmi2,lzcnt,popcnt,avx512f,avx512vl,avx512bw,avx512dq")]
-    unsafe fn packet_walk_avx512<K: PacketKernel, C: Counters, L: PacketLeaves<C>, const CLOSEST: bool>(
-        kernel: K,
-        nodes: &[WideNode],
-        rays: &PacketRays,
-        active: u32,
-        leaves: &mut L,
-        counters: &mut C,
-    ) -> u32 {
-        // SAFETY: compiled with AVX-512, which the caller guarantees.
-        unsafe {
-            if CLOSEST {
-                packet::closest(kernel, nodes, rays, active, leaves, counters);
-                0
-            } else {
-                packet::any(kernel, nodes, rays, active, leaves, counters)
-            }
-        }
+        unsafe { packet::any(Avx512Packet, nodes, rays, active, leaves, counters) }
     }
 }

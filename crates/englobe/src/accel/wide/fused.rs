@@ -49,7 +49,7 @@ use super::node::{FAR_SCALE, NodeRay, WideNode};
 /// Largest magnitude of an inverse direction's far factor and of its product with the origin
 /// for which the form applies: far enough below the largest float that the constants, rounded
 /// away from the nearest, stay finite.
-pub(super) const LARGEST: f32 = 1e38;
+const LARGEST: f32 = 1e38;
 
 /// Whether the fused form applies to a ray of origin `origin`, inverse direction `inv_dir` and
 /// start `t_min` (see the module documentation): three-lane vector operations, no branch, cheap

@@ -51,7 +51,6 @@ pub mod kernels;
 pub mod node;
 pub mod output;
 pub mod packet;
-pub mod packet_fused;
 pub mod packet_interval;
 pub mod packet_kernels;
 pub(crate) mod packet_prep;

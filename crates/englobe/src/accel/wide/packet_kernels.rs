@@ -128,8 +128,6 @@ impl PacketKernel for ScalarPacket {
 
 #[cfg(target_arch = "x86_64")]
 pub use x86::{Avx2Packet, Avx512Packet};
-#[cfg(target_arch = "x86_64")]
-pub(super) use x86::{Slabs16, children16, planes16, same_rows, within16};
 
 #[cfg(target_arch = "x86_64")]
 mod x86 {
@@ -151,149 +149,6 @@ mod x86 {
         }
     }
 
-    /// One child's entry and exit distances for every lane of a packet, as an AVX-512 kernel
-    /// computes them (the exact-order test here, the fused one in [`super::super::packet_fused`]).
-    pub(in super::super) trait Slabs16: Copy {
-        /// Entry and exit distances of child `c` of `node` in each lane, within `t_min..=lim`.
-        ///
-        /// # Safety
-        /// The caller is compiled with AVX-512 F and runs on a processor that has it.
-        unsafe fn slabs(self, node: &WideNode, c: usize, lim: __m512) -> (__m512, __m512);
-    }
-
-    /// The walk over a node's children of the AVX-512 kernels, with the per-child test `slabs`:
-    /// [`PacketKernel::children`].
-    ///
-    /// # Safety
-    /// As [`Slabs16::slabs`].
-    #[inline(always)]
-    pub(in super::super) unsafe fn children16<S: Slabs16>(
-        slabs: S,
-        node: &WideNode,
-        rays: &PacketRays,
-        active: u32,
-        limit: &Lanes,
-        out: &mut ChildHits,
-    ) -> u32 {
-        // SAFETY (for the whole function): the caller guarantees AVX-512 F; every `Lanes` is 64
-        // bytes aligned to 64, so the aligned loads and stores are in bounds and aligned.
-        unsafe {
-            let lim = _mm512_load_ps(limit.0.as_ptr());
-            let nan = _mm512_set1_ps(f32::NAN);
-            let mut mask = 0;
-            let (mut candidates, ordered) = candidates(node, rays, &mut out.near);
-            while candidates != 0 {
-                let c = candidates.trailing_zeros() as usize;
-                candidates &= candidates - 1;
-                let (enter, exit) = slabs.slabs(node, c, lim);
-                let entered = _mm512_mask_cmp_ps_mask::<_CMP_LE_OQ>(active as __mmask16, enter, exit);
-                if entered != 0 {
-                    mask |= 1 << c;
-                    _mm512_store_ps(out.dist[c].0.as_mut_ptr(), _mm512_mask_blend_ps(entered, nan, enter));
-                    out.rays[c] = entered as u32;
-                    if !ordered {
-                        out.near[c] = _mm512_mask_reduce_min_ps(entered, enter);
-                    }
-                }
-            }
-            mask
-        }
-    }
-
-    /// The planes of child `c` along axis `a` that the lanes test, near then far: one broadcast
-    /// each when the active rays go the same way along every axis (`rows`, a camera's tile nearly
-    /// always), else both planes blended by the lanes' directions (`down`).
-    ///
-    /// # Safety
-    /// As [`Slabs16::slabs`].
-    #[inline(always)]
-    pub(in super::super) unsafe fn planes16(
-        node: &WideNode,
-        c: usize,
-        a: usize,
-        rows: Option<[usize; 3]>,
-        down: __mmask16,
-    ) -> (__m512, __m512) {
-        // SAFETY: the caller's guarantee.
-        unsafe {
-            match rows {
-                Some(rows) => {
-                    // `& 1`: a row within the axis's two, with no bounds check.
-                    let near = rows[a] & 1;
-                    (_mm512_set1_ps(node.bounds[2 * a + near][c]), _mm512_set1_ps(node.bounds[2 * a + 1 - near][c]))
-                }
-                None => {
-                    let (lo, hi) = (_mm512_set1_ps(node.bounds[2 * a][c]), _mm512_set1_ps(node.bounds[2 * a + 1][c]));
-                    // The lanes going down take the upper plane as the near one.
-                    (_mm512_mask_blend_ps(down, lo, hi), _mm512_mask_blend_ps(down, hi, lo))
-                }
-            }
-        }
-    }
-
-    /// Each axis's near row when the rays of `active` all go the same way along it, for every
-    /// axis (see [`planes16`]).
-    #[inline(always)]
-    pub(in super::super) fn same_rows(rays: &PacketRays, active: u32) -> Option<[usize; 3]> {
-        let same_way = rays.down.iter().all(|&d| d & active == 0 || d & active == active);
-        same_way.then(|| rays.down.map(|d| (d & active != 0) as usize))
-    }
-
-    /// The exact-order test of the single-ray kernels, a packet's rays in the lanes.
-    #[derive(Clone, Copy)]
-    struct Exact16 {
-        origin: [__m512; 3],
-        /// The inverses negated, so that each plane is subtracted from the origins (see
-        /// `child_entry_scalar`).
-        inv: [__m512; 3],
-        inv_far: [__m512; 3],
-        t_min: __m512,
-        down: [__mmask16; 3],
-        rows: Option<[usize; 3]>,
-    }
-
-    impl Exact16 {
-        /// # Safety
-        /// As [`Slabs16::slabs`].
-        #[inline(always)]
-        unsafe fn new(rays: &PacketRays, active: u32) -> Self {
-            // SAFETY: the caller's guarantee; the rows are aligned as in `children16`.
-            unsafe {
-                let load = |l: &Lanes| _mm512_load_ps(l.0.as_ptr());
-                // The walk keeps these in registers from node to node: the negation is made once.
-                let sign = _mm512_set1_epi32(i32::MIN);
-                let negated = |l: &Lanes| _mm512_castsi512_ps(_mm512_xor_si512(_mm512_castps_si512(load(l)), sign));
-                Exact16 {
-                    origin: [load(&rays.origin[0]), load(&rays.origin[1]), load(&rays.origin[2])],
-                    inv: [negated(&rays.inv_dir[0]), negated(&rays.inv_dir[1]), negated(&rays.inv_dir[2])],
-                    inv_far: [negated(&rays.inv_far[0]), negated(&rays.inv_far[1]), negated(&rays.inv_far[2])],
-                    t_min: load(&rays.t_min),
-                    down: rays.down.map(|d| d as __mmask16),
-                    rows: same_rows(rays, active),
-                }
-            }
-        }
-    }
-
-    impl Slabs16 for Exact16 {
-        #[inline(always)]
-        unsafe fn slabs(self, node: &WideNode, c: usize, lim: __m512) -> (__m512, __m512) {
-            // SAFETY: the caller's guarantee.
-            unsafe {
-                let (mut enter, mut exit) = (self.t_min, lim);
-                for a in 0..3 {
-                    let (near, far) = planes16(node, c, a, self.rows, self.down[a]);
-                    let t_near = _mm512_mul_ps(_mm512_sub_ps(self.origin[a], near), self.inv[a]);
-                    let t_far = _mm512_mul_ps(_mm512_sub_ps(self.origin[a], far), self.inv_far[a]);
-                    // `max(a, b)` is `a > b ? a : b`, `b` when either is NaN: the scalar rule.
-                    enter = _mm512_max_ps(t_near, enter);
-                    exit = _mm512_min_ps(t_far, exit);
-                }
-                (enter, exit)
-            }
-        }
-    }
-
     /// Sixteen lanes with AVX-512: the whole packet in one register, the direction signs in mask
     /// registers.
     #[derive(Clone, Copy, Debug)]
@@ -309,27 +164,73 @@ mod x86 {
             limit: &Lanes,
             out: &mut ChildHits,
         ) -> u32 {
-            // SAFETY: the caller guarantees AVX-512 F.
-            unsafe { children16(Exact16::new(rays, active), node, rays, active, limit, out) }
+            // SAFETY (for the whole function): the caller guarantees AVX-512 F; every `Lanes` is
+            // 64 bytes aligned to 64, so the aligned loads and stores are in bounds and aligned.
+            unsafe {
+                let load = |l: &Lanes| _mm512_load_ps(l.0.as_ptr());
+                // The inverses negated, so that each plane is subtracted from the origins straight
+                // from memory, broadcast by the subtraction (see `child_entry_scalar`). The walk
+                // keeps them in registers from node to node: the negation is made once.
+                let sign = _mm512_set1_epi32(i32::MIN);
+                let negated = |l: &Lanes| _mm512_castsi512_ps(_mm512_xor_si512(_mm512_castps_si512(load(l)), sign));
+                let o = [load(&rays.origin[0]), load(&rays.origin[1]), load(&rays.origin[2])];
+                let inv = [negated(&rays.inv_dir[0]), negated(&rays.inv_dir[1]), negated(&rays.inv_dir[2])];
+                let inv_far = [negated(&rays.inv_far[0]), negated(&rays.inv_far[1]), negated(&rays.inv_far[2])];
+                let down = rays.down.map(|d| d as __mmask16);
+                let (t_min, lim) = (load(&rays.t_min), load(limit));
+                let nan = _mm512_set1_ps(f32::NAN);
+                // When the active rays go the same way along every axis (a camera's tile, nearly
+                // always), each axis's near and far rows are the same for all of them: no blend.
+                let same_way = rays.down.iter().all(|&d| d & active == 0 || d & active == active);
+                let rows = rays.down.map(|d| (d & active != 0) as usize);
+                let mut mask = 0;
+                let (mut candidates, ordered) = candidates(node, rays, &mut out.near);
+                while candidates != 0 {
+                    let c = candidates.trailing_zeros() as usize;
+                    candidates &= candidates - 1;
+                    let (mut enter, mut exit) = (t_min, lim);
+                    for a in 0..3 {
+                        let (t_near, t_far) = if same_way {
+                            let near = _mm512_set1_ps(node.bounds[2 * a + rows[a]][c]);
+                            let far = _mm512_set1_ps(node.bounds[2 * a + 1 - rows[a]][c]);
+                            (
+                                _mm512_mul_ps(_mm512_sub_ps(o[a], near), inv[a]),
+                                _mm512_mul_ps(_mm512_sub_ps(o[a], far), inv_far[a]),
+                            )
+                        } else {
+                            let lo = _mm512_sub_ps(o[a], _mm512_set1_ps(node.bounds[2 * a][c]));
+                            let hi = _mm512_sub_ps(o[a], _mm512_set1_ps(node.bounds[2 * a + 1][c]));
+                            // The lanes going down take the upper plane as the near one.
+                            (
+                                _mm512_mul_ps(_mm512_mask_blend_ps(down[a], lo, hi), inv[a]),
+                                _mm512_mul_ps(_mm512_mask_blend_ps(down[a], hi, lo), inv_far[a]),
+                            )
+                        };
+                        // `max(a, b)` is `a > b ? a : b`, `b` when either is NaN: the scalar rule.
+                        enter = _mm512_max_ps(t_near, enter);
+                        exit = _mm512_min_ps(t_far, exit);
+                    }
+                    let entered = _mm512_mask_cmp_ps_mask::<_CMP_LE_OQ>(active as __mmask16, enter, exit);
+                    if entered != 0 {
+                        mask |= 1 << c;
+                        _mm512_store_ps(out.dist[c].0.as_mut_ptr(), _mm512_mask_blend_ps(entered, nan, enter));
+                        out.rays[c] = entered as u32;
+                        if !ordered {
+                            out.near[c] = _mm512_mask_reduce_min_ps(entered, enter);
+                        }
+                    }
+                }
+                mask
+            }
         }
 
         #[inline(always)]
         unsafe fn within(self, dist: &Lanes, limit: &Lanes, active: u32) -> u32 {
-            // SAFETY: the caller guarantees AVX-512 F.
-            unsafe { within16(dist, limit, active) }
-        }
-    }
-
-    /// The rays of `active` whose entry distance is within their limit: [`PacketKernel::within`].
-    ///
-    /// # Safety
-    /// As [`Slabs16::slabs`].
-    #[inline(always)]
-    pub(in super::super) unsafe fn within16(dist: &Lanes, limit: &Lanes, active: u32) -> u32 {
-        // SAFETY: the caller's guarantee; `Lanes` are aligned to 64.
-        unsafe {
-            let (d, l) = (_mm512_load_ps(dist.0.as_ptr()), _mm512_load_ps(limit.0.as_ptr()));
-            _mm512_mask_cmp_ps_mask::<_CMP_LE_OQ>(active as __mmask16, d, l) as u32
+            // SAFETY: AVX-512 F is guaranteed by the caller; `Lanes` are aligned to 64.
+            unsafe {
+                let (d, l) = (_mm512_load_ps(dist.0.as_ptr()), _mm512_load_ps(limit.0.as_ptr()));
+                _mm512_mask_cmp_ps_mask::<_CMP_LE_OQ>(active as __mmask16, d, l) as u32
+            }
         }
     }
 
