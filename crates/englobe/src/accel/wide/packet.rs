@@ -64,20 +64,15 @@ pub fn fits(depth: u32) -> bool {
     depth as usize <= INLINE_DEPTH
 }
 
-/// The children of `hits` in `mask` in `order`, returning how many: for closest hits
-/// (`CLOSEST`) nearest first by where their rays enter them, for occlusion farthest first by
-/// where their rays leave them ([`PacketKernel::children_exits`]), as the single-ray walks order
-/// them (see [`super::traverse`]).
+/// The children of `hits` in `mask`, nearest first, in `order`; returns how many.
 #[inline(always)]
-fn sorted_children<const CLOSEST: bool>(hits: &ChildHits, mut mask: u32, order: &mut [u8; WIDTH]) -> usize {
-    // Ascending keys either way: the exits negated.
-    let key = |c: u8| if CLOSEST { hits.near[c as usize] } else { -hits.far[c as usize] };
+fn sorted_children(hits: &ChildHits, mut mask: u32, order: &mut [u8; WIDTH]) -> usize {
     let mut n = 0;
     while mask != 0 {
         let c = mask.trailing_zeros() as u8;
         mask &= mask - 1;
         let mut j = n;
-        while j > 0 && key(order[j - 1]) > key(c) {
+        while j > 0 && hits.near[order[j - 1] as usize] > hits.near[c as usize] {
             order[j] = order[j - 1];
             j -= 1;
         }
@@ -170,20 +165,15 @@ unsafe fn walk<K: PacketKernel, C: Counters, L: PacketLeaves<C>>(
                 counters.box_tests(WIDTH as u32);
             }
             // SAFETY: the caller's guarantee.
-            let mask = unsafe {
-                if closest {
-                    kernel.children(node, rays, current, leaves.limits(), &mut hits)
-                } else {
-                    kernel.children_exits(node, rays, current, leaves.limits(), &mut hits)
-                }
-            };
+            let mask = unsafe { kernel.children(node, rays, current, leaves.limits(), &mut hits) };
             if mask != 0 {
                 prefetch_children_of(nodes, node, mask, |first| leaves.prefetch(first));
-                let n = if closest {
-                    sorted_children::<true>(&hits, mask, &mut order)
-                } else {
-                    sorted_children::<false>(&hits, mask, &mut order)
-                };
+                let n = sorted_children(&hits, mask, &mut order);
+                if !closest {
+                    // Occlusion: the farthest first, as the single-ray walk does (see
+                    // `super::traverse`).
+                    order[..n].reverse();
+                }
                 // The others pushed last-taken first, the first one taken now.
                 for &c in order[1..n].iter().rev() {
                     let c = c as usize;

@@ -113,20 +113,13 @@ impl PacketInterval {
         mask
     }
 
-    /// [`PacketInterval::candidates_scalar`] on the eight slots at once, with AVX; the bounds'
-    /// entries into each slot in `enter_at` and, if `EXITS`, their exits in `exit_at` (no less
-    /// than where any ray of the packet leaves the slot's box, the rays' limits aside).
+    /// [`PacketInterval::candidates_scalar`] on the eight slots at once, with AVX.
     ///
     /// # Safety
     /// The caller is compiled with AVX and runs on a processor that has it.
     #[cfg(target_arch = "x86_64")]
     #[inline(always)]
-    pub unsafe fn candidates_avx<const EXITS: bool>(
-        &self,
-        node: &WideNode,
-        enter_at: &mut [f32; WIDTH],
-        exit_at: &mut [f32; WIDTH],
-    ) -> u32 {
+    pub unsafe fn candidates_avx(&self, node: &WideNode, enter_at: &mut [f32; WIDTH]) -> u32 {
         use std::arch::x86_64::*;
         const { assert!(ROWS == 6 && WIDTH == 8) };
         // SAFETY: AVX is the caller's guarantee; `near_row` is below `ROWS` (made so by `new`),
@@ -151,9 +144,6 @@ impl PacketInterval {
                 exit = _mm256_min_ps(upper, exit);
             }
             _mm256_storeu_ps(enter_at.as_mut_ptr(), enter);
-            if EXITS {
-                _mm256_storeu_ps(exit_at.as_mut_ptr(), exit);
-            }
             _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(enter, exit)) as u32
         }
     }
@@ -208,22 +198,7 @@ mod tests {
             #[cfg(target_arch = "x86_64")]
             if std::arch::is_x86_feature_detected!("avx") {
                 // SAFETY: the processor has AVX (the function is not inlined into this one).
-                let (mut enter_at, mut exit_at) = ([0.0; WIDTH], [0.0; WIDTH]);
-                // SAFETY: as above.
-                let with_exits = unsafe { interval.candidates_avx::<true>(&node, &mut enter_at, &mut exit_at) };
-                assert_eq!(with_exits, candidates);
-                // The bounds hold every entering ray's entry and exit.
-                for slot in (0..WIDTH).filter(|&s| candidates >> s & 1 != 0) {
-                    for r in &rays {
-                        let ray = NodeRay::new(r);
-                        if let Some(enter) = child_entry_scalar(&node, slot, &ray, f32::INFINITY) {
-                            let exit = (0..3)
-                                .map(|a| (ray.origin[a] - node.bounds[ray.row_index(a, 1)][slot]) * -ray.inv_far[a])
-                                .fold(f32::INFINITY, f32::min);
-                            assert!(enter_at[slot] <= enter && exit <= exit_at[slot], "slot {slot}, {r:?}");
-                        }
-                    }
-                }
+                assert_eq!(unsafe { interval.candidates_avx(&node, &mut [0.0; WIDTH]) }, candidates);
             }
             for slot in 0..WIDTH {
                 let any_enters =

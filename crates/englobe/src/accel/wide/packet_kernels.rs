@@ -32,17 +32,12 @@ pub struct ChildHits {
     /// the SIMD kernels of a packet with an interval ([`PacketRays::bound`]), the interval's lower
     /// bound of every ray's entry distance (no greater, and made without a reduction per child).
     pub near: [f32; WIDTH],
-    /// The order of the occlusion walk ([`PacketKernel::children_exits`]): the greatest exit
-    /// distance from each child over its rays, or, in the SIMD kernels of a packet with an
-    /// interval, the interval's upper bound of every ray's exit (no less). Not written by
-    /// [`PacketKernel::children`].
-    pub far: [f32; WIDTH],
 }
 
 impl ChildHits {
     /// Nothing yet.
     pub const NONE: ChildHits =
-        ChildHits { dist: [Lanes([f32::NAN; PACKET]); WIDTH], rays: [0; WIDTH], near: [0.0; WIDTH], far: [0.0; WIDTH] };
+        ChildHits { dist: [Lanes([f32::NAN; PACKET]); WIDTH], rays: [0; WIDTH], near: [0.0; WIDTH] };
 }
 
 /// A slab test of every child of a node against a packet.
@@ -54,21 +49,6 @@ pub trait PacketKernel: Copy {
     /// # Safety
     /// As [`super::kernels::NodeKernel::children`].
     unsafe fn children(
-        self,
-        node: &WideNode,
-        rays: &PacketRays,
-        active: u32,
-        limit: &Lanes,
-        out: &mut ChildHits,
-    ) -> u32;
-
-    /// [`PacketKernel::children`], with `out.far` written too: where the rays leave each child
-    /// entered, at the farthest, what occlusion walks order the children by (as the single-ray
-    /// walk, see [`super::traverse`]).
-    ///
-    /// # Safety
-    /// As [`PacketKernel::children`].
-    unsafe fn children_exits(
         self,
         node: &WideNode,
         rays: &PacketRays,
@@ -100,47 +80,12 @@ impl PacketKernel for ScalarPacket {
         limit: &Lanes,
         out: &mut ChildHits,
     ) -> u32 {
-        scalar_children::<false>(node, rays, active, limit, out)
-    }
-
-    #[inline(always)]
-    unsafe fn children_exits(
-        self,
-        node: &WideNode,
-        rays: &PacketRays,
-        active: u32,
-        limit: &Lanes,
-        out: &mut ChildHits,
-    ) -> u32 {
-        scalar_children::<true>(node, rays, active, limit, out)
-    }
-
-    #[inline(always)]
-    unsafe fn within(self, dist: &Lanes, limit: &Lanes, active: u32) -> u32 {
-        let mut m = 0;
-        for i in 0..PACKET {
-            m |= ((dist.0[i] <= limit.0[i]) as u32) << i;
-        }
-        m & active
-    }
-}
-
-/// The scalar packet kernel's test, with the children's farthest exits if `EXITS`.
-#[inline(always)]
-fn scalar_children<const EXITS: bool>(
-    node: &WideNode,
-    rays: &PacketRays,
-    active: u32,
-    limit: &Lanes,
-    out: &mut ChildHits,
-) -> u32 {
-    {
         let mut mask = 0;
         for c in 0..WIDTH {
             if node.children[c] == EMPTY {
                 continue;
             }
-            let (mut entered, mut near, mut far) = (0, f32::INFINITY, f32::NEG_INFINITY);
+            let (mut entered, mut near) = (0, f32::INFINITY);
             for i in 0..PACKET {
                 let mut d = f32::NAN;
                 if active >> i & 1 != 0 {
@@ -158,7 +103,6 @@ fn scalar_children<const EXITS: bool>(
                         d = enter;
                         entered |= 1 << i;
                         near = near.min(enter);
-                        far = far.max(exit);
                     }
                 }
                 out.dist[c].0[i] = d;
@@ -167,12 +111,18 @@ fn scalar_children<const EXITS: bool>(
                 mask |= 1 << c;
                 out.rays[c] = entered;
                 out.near[c] = near;
-                if EXITS {
-                    out.far[c] = far;
-                }
             }
         }
         mask
+    }
+
+    #[inline(always)]
+    unsafe fn within(self, dist: &Lanes, limit: &Lanes, active: u32) -> u32 {
+        let mut m = 0;
+        for i in 0..PACKET {
+            m |= ((dist.0[i] <= limit.0[i]) as u32) << i;
+        }
+        m & active
     }
 }
 
@@ -186,16 +136,15 @@ mod x86 {
     use super::{ChildHits, EMPTY, Lanes, PACKET, PacketKernel, PacketRays, WIDTH, WideNode};
 
     /// The children worth a ray test: those the packet's interval does not cull, with the
-    /// interval's entry distances in `out.near` and, if `EXITS`, its exit distances in `out.far`
-    /// (then `true`), or every used slot if it has none.
+    /// interval's entry distances in `near` (then `true`), or every used slot if it has none.
     ///
     /// # Safety
     /// The caller is compiled with AVX and runs on a processor that has it.
     #[inline(always)]
-    unsafe fn candidates<const EXITS: bool>(node: &WideNode, rays: &PacketRays, out: &mut ChildHits) -> (u32, bool) {
+    unsafe fn candidates(node: &WideNode, rays: &PacketRays, near: &mut [f32; WIDTH]) -> (u32, bool) {
         match &rays.interval {
             // SAFETY: the caller's guarantee.
-            Some(interval) => (unsafe { interval.candidates_avx::<EXITS>(node, &mut out.near, &mut out.far) }, true),
+            Some(interval) => (unsafe { interval.candidates_avx(node, near) }, true),
             None => ((0..WIDTH).filter(|&c| node.children[c] != EMPTY).fold(0, |m, c| m | 1 << c), false),
         }
     }
@@ -215,46 +164,6 @@ mod x86 {
             limit: &Lanes,
             out: &mut ChildHits,
         ) -> u32 {
-            // SAFETY: the caller's guarantee.
-            unsafe { children16::<false>(node, rays, active, limit, out) }
-        }
-
-        #[inline(always)]
-        unsafe fn children_exits(
-            self,
-            node: &WideNode,
-            rays: &PacketRays,
-            active: u32,
-            limit: &Lanes,
-            out: &mut ChildHits,
-        ) -> u32 {
-            // SAFETY: the caller's guarantee.
-            unsafe { children16::<true>(node, rays, active, limit, out) }
-        }
-
-        #[inline(always)]
-        unsafe fn within(self, dist: &Lanes, limit: &Lanes, active: u32) -> u32 {
-            // SAFETY: AVX-512 F is guaranteed by the caller; `Lanes` are aligned to 64.
-            unsafe {
-                let (d, l) = (_mm512_load_ps(dist.0.as_ptr()), _mm512_load_ps(limit.0.as_ptr()));
-                _mm512_mask_cmp_ps_mask::<_CMP_LE_OQ>(active as __mmask16, d, l) as u32
-            }
-        }
-    }
-
-    /// The AVX-512 kernel's test, with the children's farthest exits if `EXITS`.
-    ///
-    /// # Safety
-    /// As [`PacketKernel::children`], for AVX-512 F.
-    #[inline(always)]
-    unsafe fn children16<const EXITS: bool>(
-        node: &WideNode,
-        rays: &PacketRays,
-        active: u32,
-        limit: &Lanes,
-        out: &mut ChildHits,
-    ) -> u32 {
-        {
             // SAFETY (for the whole function): the caller guarantees AVX-512 F; every `Lanes` is
             // 64 bytes aligned to 64, so the aligned loads and stores are in bounds and aligned.
             unsafe {
@@ -275,7 +184,7 @@ mod x86 {
                 let same_way = rays.down.iter().all(|&d| d & active == 0 || d & active == active);
                 let rows = rays.down.map(|d| (d & active != 0) as usize);
                 let mut mask = 0;
-                let (mut candidates, ordered) = candidates::<EXITS>(node, rays, out);
+                let (mut candidates, ordered) = candidates(node, rays, &mut out.near);
                 while candidates != 0 {
                     let c = candidates.trailing_zeros() as usize;
                     candidates &= candidates - 1;
@@ -309,12 +218,18 @@ mod x86 {
                         if !ordered {
                             out.near[c] = _mm512_mask_reduce_min_ps(entered, enter);
                         }
-                        if EXITS && !ordered {
-                            out.far[c] = _mm512_mask_reduce_max_ps(entered, exit);
-                        }
                     }
                 }
                 mask
+            }
+        }
+
+        #[inline(always)]
+        unsafe fn within(self, dist: &Lanes, limit: &Lanes, active: u32) -> u32 {
+            // SAFETY: AVX-512 F is guaranteed by the caller; `Lanes` are aligned to 64.
+            unsafe {
+                let (d, l) = (_mm512_load_ps(dist.0.as_ptr()), _mm512_load_ps(limit.0.as_ptr()));
+                _mm512_mask_cmp_ps_mask::<_CMP_LE_OQ>(active as __mmask16, d, l) as u32
             }
         }
     }
@@ -335,51 +250,6 @@ mod x86 {
             limit: &Lanes,
             out: &mut ChildHits,
         ) -> u32 {
-            // SAFETY: the caller's guarantee.
-            unsafe { children8::<false>(node, rays, active, limit, out) }
-        }
-
-        #[inline(always)]
-        unsafe fn children_exits(
-            self,
-            node: &WideNode,
-            rays: &PacketRays,
-            active: u32,
-            limit: &Lanes,
-            out: &mut ChildHits,
-        ) -> u32 {
-            // SAFETY: the caller's guarantee.
-            unsafe { children8::<true>(node, rays, active, limit, out) }
-        }
-
-        #[inline(always)]
-        unsafe fn within(self, dist: &Lanes, limit: &Lanes, active: u32) -> u32 {
-            // SAFETY: AVX is guaranteed by the caller; the halves are aligned to 32.
-            unsafe {
-                let mut m = 0;
-                for h in 0..2 {
-                    let d = _mm256_load_ps(dist.0.as_ptr().add(HALF * h));
-                    let l = _mm256_load_ps(limit.0.as_ptr().add(HALF * h));
-                    m |= (_mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(d, l)) as u32) << (HALF * h);
-                }
-                m & active
-            }
-        }
-    }
-
-    /// The AVX2 kernel's test, with the children's farthest exits if `EXITS`.
-    ///
-    /// # Safety
-    /// As [`PacketKernel::children`], for AVX2.
-    #[inline(always)]
-    unsafe fn children8<const EXITS: bool>(
-        node: &WideNode,
-        rays: &PacketRays,
-        active: u32,
-        limit: &Lanes,
-        out: &mut ChildHits,
-    ) -> u32 {
-        {
             // SAFETY (for the whole function): the caller guarantees AVX2; each half of a `Lanes`
             // is 32 bytes at an offset of 0 or 32 from a 64-aligned start.
             unsafe {
@@ -387,8 +257,7 @@ mod x86 {
                 let nan = _mm256_set1_ps(f32::NAN);
                 let mut entered = [0u32; WIDTH];
                 let mut near = [_mm256_set1_ps(f32::INFINITY); WIDTH];
-                let mut far = [_mm256_set1_ps(f32::NEG_INFINITY); WIDTH];
-                let (candidates, ordered) = candidates::<EXITS>(node, rays, out);
+                let (candidates, ordered) = candidates(node, rays, &mut out.near);
                 for h in 0..2 {
                     // Both halves run even when one has no active ray, so that every lane of an
                     // entered child's distances is written.
@@ -432,10 +301,6 @@ mod x86 {
                             _mm256_store_ps(out.dist[c].0.as_mut_ptr().add(HALF * h), d);
                             // NaN lanes lose every `min` (the second operand is returned).
                             near[c] = _mm256_min_ps(d, near[c]);
-                            if EXITS {
-                                let e = _mm256_blendv_ps(_mm256_set1_ps(f32::NEG_INFINITY), exit, keep);
-                                far[c] = _mm256_max_ps(e, far[c]);
-                            }
                             entered[c] |= m << (HALF * h);
                         } else {
                             _mm256_store_ps(out.dist[c].0.as_mut_ptr().add(HALF * h), nan);
@@ -447,11 +312,6 @@ mod x86 {
                     if entered[c] != 0 {
                         mask |= 1 << c;
                         out.rays[c] = entered[c];
-                        if EXITS && !ordered {
-                            let mut f = [0.0f32; HALF];
-                            _mm256_storeu_ps(f.as_mut_ptr(), far[c]);
-                            out.far[c] = f.iter().fold(f32::NEG_INFINITY, |a, &b| a.max(b));
-                        }
                         if ordered {
                             continue;
                         }
@@ -461,6 +321,20 @@ mod x86 {
                     }
                 }
                 mask
+            }
+        }
+
+        #[inline(always)]
+        unsafe fn within(self, dist: &Lanes, limit: &Lanes, active: u32) -> u32 {
+            // SAFETY: AVX is guaranteed by the caller; the halves are aligned to 32.
+            unsafe {
+                let mut m = 0;
+                for h in 0..2 {
+                    let d = _mm256_load_ps(dist.0.as_ptr().add(HALF * h));
+                    let l = _mm256_load_ps(limit.0.as_ptr().add(HALF * h));
+                    m |= (_mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(d, l)) as u32) << (HALF * h);
+                }
+                m & active
             }
         }
     }
@@ -478,16 +352,6 @@ mod tests {
     use crate::accel::wide::packet_interval::PacketInterval;
     use crate::{Aabb, Ray};
 
-    /// Where the ray leaves child `slot` of `node`, within `limit`: the single-ray test's exit.
-    fn exit_scalar(node: &WideNode, slot: usize, ray: &NodeRay, limit: f32) -> f32 {
-        let mut exit = limit;
-        for a in 0..3 {
-            let t_far = (ray.origin[a] - node.bounds[ray.row_index(a, 1)][slot]) * -ray.inv_far[a];
-            exit = if t_far < exit { t_far } else { exit };
-        }
-        exit
-    }
-
     /// The kernel of `isa` on the packet, its lanes compared with the scalar packet kernel's, and
     /// those with the single-ray scalar test, bit for bit.
     fn check(isa: Isa, node: &WideNode, rays: &[Ray], active: u32, bounded: bool) -> u32 {
@@ -496,40 +360,23 @@ mod tests {
             packet.bound(active);
         }
         let limit = Lanes(std::array::from_fn(|i| rays.get(i).map_or(0.0, |r| reach(r.t_max))));
-        let (mut got, mut with_exits) = (ChildHits::NONE, ChildHits::NONE);
+        let mut got = ChildHits::NONE;
         // SAFETY: each kernel runs only if the processor has its instruction set.
-        let (mask, exits_mask) = unsafe {
+        let mask = unsafe {
             match isa {
-                Isa::Portable => (
-                    ScalarPacket.children(node, &packet, active, &limit, &mut got),
-                    ScalarPacket.children_exits(node, &packet, active, &limit, &mut with_exits),
-                ),
+                Isa::Portable => ScalarPacket.children(node, &packet, active, &limit, &mut got),
                 #[cfg(target_arch = "x86_64")]
-                Isa::Avx2 => (
-                    Avx2Packet.children(node, &packet, active, &limit, &mut got),
-                    Avx2Packet.children_exits(node, &packet, active, &limit, &mut with_exits),
-                ),
+                Isa::Avx2 => Avx2Packet.children(node, &packet, active, &limit, &mut got),
                 #[cfg(target_arch = "x86_64")]
-                Isa::Avx512 => (
-                    Avx512Packet.children(node, &packet, active, &limit, &mut got),
-                    Avx512Packet.children_exits(node, &packet, active, &limit, &mut with_exits),
-                ),
+                Isa::Avx512 => Avx512Packet.children(node, &packet, active, &limit, &mut got),
                 #[cfg(not(target_arch = "x86_64"))]
                 _ => unreachable!(),
             }
         };
-        // The test with exits is the same test.
-        assert_eq!(exits_mask, mask, "{isa}: exits");
-        for slot in (0..WIDTH).filter(|&s| mask >> s & 1 != 0) {
-            assert_eq!(with_exits.rays[slot], got.rays[slot], "{isa}: exits, rays of slot {slot}");
-            assert_eq!(with_exits.near[slot].to_bits(), got.near[slot].to_bits(), "{isa}: exits, slot {slot}");
-            let bits = |l: &Lanes| l.0.map(f32::to_bits);
-            assert_eq!(bits(&with_exits.dist[slot]), bits(&got.dist[slot]), "{isa}: exits, slot {slot}");
-        }
         let mut entered = 0;
         for slot in 0..WIDTH {
             let mut rays_in = 0;
-            let (mut near, mut far) = (f32::INFINITY, f32::NEG_INFINITY);
+            let mut near = f32::INFINITY;
             for (i, ray) in rays.iter().enumerate() {
                 let expected = if active >> i & 1 != 0 {
                     child_entry_scalar(node, slot, &NodeRay::new(ray), limit.0[i])
@@ -539,7 +386,6 @@ mod tests {
                 if let Some(d) = expected {
                     rays_in |= 1 << i;
                     near = near.min(d);
-                    far = far.max(exit_scalar(node, slot, &NodeRay::new(ray), limit.0[i]));
                 }
                 if mask >> slot & 1 != 0 {
                     let lane = got.dist[slot].0[i];
@@ -563,11 +409,6 @@ mod tests {
             assert_eq!(mask >> slot & 1 != 0, rays_in != 0, "{isa}: slot {slot}");
             if rays_in != 0 {
                 assert_eq!(got.rays[slot], rays_in, "{isa}: rays of slot {slot}");
-                if packet.interval.is_some() && isa != Isa::Portable {
-                    assert!(with_exits.far[slot] >= far, "{isa}: bound of the farthest exit of slot {slot}");
-                } else {
-                    assert_eq!(with_exits.far[slot], far, "{isa}: farthest exit of slot {slot}");
-                }
                 if packet.interval.is_some() && isa != Isa::Portable {
                     assert!(got.near[slot] <= near, "{isa}: bound of the nearest entry of slot {slot}");
                 } else {
