@@ -250,11 +250,12 @@ mod x86 {
             let o_k = [load(&r.origin_k[0]), load(&r.origin_k[1]), load(&r.origin_k[2])];
             let (sx, sy, sz) = (load(&r.shear[0]), load(&r.shear[1]), load(&r.shear[2]));
             let zero = _mm512_setzero_ps();
-            let abs = |x: __m512| _mm512_abs_ps(x);
-            let normal = |x: __m512| {
-                _mm512_cmp_ps_mask::<_CMP_GE_OQ>(abs(x), _mm512_set1_ps(f32::MIN_POSITIVE))
-                    & _mm512_cmp_ps_mask::<_CMP_LT_OQ>(abs(x), _mm512_set1_ps(f32::INFINITY))
-            };
+            // The lanes holding a normal number, or a finite one, each class test one `vfpclassps`
+            // (the same lanes as `MIN_POSITIVE <= |x| < inf` and `|x| < inf`): its categories are
+            // quiet NaN 0x01, +0 0x02, -0 0x04, +inf 0x08, -inf 0x10, subnormal 0x20 and
+            // signalling NaN 0x80.
+            let normal = |x: __m512| !_mm512_fpclass_ps_mask::<0xbf>(x);
+            let finite = |x: __m512| !_mm512_fpclass_ps_mask::<0x99>(x);
             let (mut hit_rays, mut special_pairs) = (0u16, 0u64);
             for lane in 0..LANES {
                 let id = block.ids[lane];
@@ -298,7 +299,7 @@ mod x86 {
                     );
                     let inv_det = _mm512_div_ps(_mm512_set1_ps(1.0), det);
                     let t = _mm512_mul_ps(t_scaled, inv_det);
-                    let finite = _mm512_cmp_ps_mask::<_CMP_LT_OQ>(abs(t), _mm512_set1_ps(f32::INFINITY));
+                    let finite = finite(t);
                     special |= candidate & !finite;
                     let candidate = candidate & finite;
                     // The box-stretch correction, as the block test computes it.
