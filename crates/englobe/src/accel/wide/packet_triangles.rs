@@ -257,6 +257,10 @@ mod x86 {
             let normal = |x: __m512| !_mm512_fpclass_ps_mask::<0xbf>(x);
             let finite = |x: __m512| !_mm512_fpclass_ps_mask::<0x99>(x);
             let (mut hit_rays, mut special_pairs) = (0u16, 0u64);
+            // The four triangles' boxes, made at the block's first candidate lane (most blocks
+            // have none) for all four at once, as the block test makes them: `min` and `max` of
+            // the three vertices' rows, in its order.
+            let (mut lows, mut highs, mut boxes_made) = ([[0.0f32; LANES]; 3], [[0.0f32; LANES]; 3], false);
             for lane in 0..LANES {
                 let id = block.ids[lane];
                 if id == UNUSED {
@@ -303,10 +307,19 @@ mod x86 {
                     special |= candidate & !finite;
                     let candidate = candidate & finite;
                     // The box-stretch correction, as the block test computes it.
+                    if !boxes_made {
+                        for axis in 0..3 {
+                            // The block's rows are 16 bytes aligned to 16.
+                            let row = |k: usize| _mm_load_ps(block.v[3 * k + axis].as_ptr());
+                            let (p, q, s) = (row(0), row(1), row(2));
+                            _mm_storeu_ps(lows[axis].as_mut_ptr(), _mm_min_ps(_mm_min_ps(p, q), s));
+                            _mm_storeu_ps(highs[axis].as_mut_ptr(), _mm_max_ps(_mm_max_ps(p, q), s));
+                        }
+                        boxes_made = true;
+                    }
                     let (mut enter, mut exit) = (_mm512_set1_ps(f32::NEG_INFINITY), _mm512_set1_ps(f32::INFINITY));
                     for axis in 0..3 {
-                        let (p, q, s) = (at(0, axis), at(1, axis), at(2, axis));
-                        let (lo, hi) = (_mm512_set1_ps(p.min(q).min(s)), _mm512_set1_ps(p.max(q).max(s)));
+                        let (lo, hi) = (_mm512_set1_ps(lows[axis][lane]), _mm512_set1_ps(highs[axis][lane]));
                         let inv = load(&packet.inv_dir[axis]);
                         let o = load(&packet.origin[axis]);
                         let positive_dir = _mm512_cmp_ps_mask::<_CMP_GE_OQ>(inv, zero);
