@@ -261,6 +261,10 @@ mod x86 {
             // have none) for all four at once, as the block test makes them: `min` and `max` of
             // the three vertices' rows, in its order.
             let (mut lows, mut highs, mut boxes_made) = ([[0.0f32; LANES]; 3], [[0.0f32; LANES]; 3], false);
+            // The rays' rows the correction reads, and the lanes going up each axis, once per block.
+            let inv = [load(&packet.inv_dir[0]), load(&packet.inv_dir[1]), load(&packet.inv_dir[2])];
+            let origin = [load(&packet.origin[0]), load(&packet.origin[1]), load(&packet.origin[2])];
+            let up = inv.map(|inv| _mm512_cmp_ps_mask::<_CMP_GE_OQ>(inv, zero));
             for lane in 0..LANES {
                 let id = block.ids[lane];
                 if id == UNUSED {
@@ -320,11 +324,9 @@ mod x86 {
                     let (mut enter, mut exit) = (_mm512_set1_ps(f32::NEG_INFINITY), _mm512_set1_ps(f32::INFINITY));
                     for axis in 0..3 {
                         let (lo, hi) = (_mm512_set1_ps(lows[axis][lane]), _mm512_set1_ps(highs[axis][lane]));
-                        let inv = load(&packet.inv_dir[axis]);
-                        let o = load(&packet.origin[axis]);
-                        let positive_dir = _mm512_cmp_ps_mask::<_CMP_GE_OQ>(inv, zero);
-                        let near = _mm512_mask_blend_ps(positive_dir, hi, lo);
-                        let far = _mm512_mask_blend_ps(positive_dir, lo, hi);
+                        let (inv, o) = (inv[axis], origin[axis]);
+                        let near = _mm512_mask_blend_ps(up[axis], hi, lo);
+                        let far = _mm512_mask_blend_ps(up[axis], lo, hi);
                         let t_near = _mm512_mul_ps(_mm512_sub_ps(near, o), inv);
                         let t_far =
                             _mm512_mul_ps(_mm512_mul_ps(_mm512_sub_ps(far, o), inv), _mm512_set1_ps(ROBUST_FAR_SCALE));
