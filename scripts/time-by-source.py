@@ -14,7 +14,7 @@ For example, the packet walk inside the Sponza:
 
     perf record -e cpu-clock -F 10000 -o packets.data target/release/englobe-bench --threads 1 \\
         --reps 150 --build-reps 1 --no-check --quiet --libraries englobe-packet16 \\
-        --cells primary-closest --resolution 512 --csv /tmp/packets.csv \\
+        --cells primary-closest --resolution 512 --csv target/packets.csv \\
         sponza-inside=../shared/scenes/meshes/sponza-dabrovic/sponza.obj \\
         --view "sponza-inside=-10.43876,7.37331,0.00149,1,0,0,60"
     scripts/time-by-source.py packets.data target/release/englobe-bench \\
