@@ -8,7 +8,7 @@
 
 use englobe::accel::wide::isa::Isa;
 use englobe::accel::wide::packet_kernels::{PACKET, PacketRays};
-use englobe::accel::wide::packet_triangles::{PacketBest, PacketTriRays, block_avx2, block_avx512};
+use englobe::accel::wide::packet_triangles::{PacketBest, PacketTriRays, block_avx2, block_avx512, shared_axes_avx512};
 use englobe::accel::wide::triangles::{TriBlock, TriRay, intersect_block};
 use englobe::{Ray, Vec3};
 use rand::{RngExt, SeedableRng};
@@ -85,4 +85,36 @@ fn whole_packet_triangle_tests_answer_as_the_single_ray_block_test() {
     if !isas.is_empty() {
         assert!(hits > 2_500 && specials > 1_000 && misses > 3_000, "{hits} hits, {specials} special, {misses} misses");
     }
+}
+
+#[test]
+fn packets_share_their_axes_with_avx512_as_in_the_portable_form() {
+    if !Isa::available().contains(&Isa::Avx512) {
+        return;
+    }
+    // Components equal in magnitude (ties between axes), zeros of both signs, a NaN now and then:
+    // every way the choice of the largest axis and its sign can go.
+    let values = [1.0f32, -1.0, 0.5, -0.5, 0.0, -0.0, 2.0, -2.0, f32::NAN];
+    let mut rng = Pcg32::seed_from_u64(0xa3e5_5a3e);
+    let (mut shared, mut not) = (0, 0);
+    for round in 0..20_000 {
+        // Most packets from a few directions, so that many share their axes.
+        let few: Vec<Vec3> = (0..1 + round % 3)
+            .map(|_| {
+                let mut pick = || values[rng.random_range(0..values.len())];
+                Vec3::new(pick(), pick(), pick())
+            })
+            .collect();
+        let rays: Vec<Ray> = (0..1 + rng.random_range(0..PACKET))
+            .map(|_| Ray::new(Vec3::ZERO, few[rng.random_range(0..few.len())]))
+            .collect();
+        let packet = PacketRays::new(&rays);
+        let active = rng.random_range(0..1u32 << rays.len());
+        let expected = PacketTriRays::shared_axes(&packet, active);
+        // SAFETY: the processor has AVX-512 (checked above).
+        assert_eq!(unsafe { shared_axes_avx512(&packet, active) }, expected, "lanes {active:b} of {rays:?}");
+        shared += expected.is_some() as u32;
+        not += expected.is_none() as u32;
+    }
+    assert!(shared > 5_000 && not > 5_000, "{shared} shared, {not} not");
 }

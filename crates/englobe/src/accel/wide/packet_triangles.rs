@@ -156,6 +156,15 @@ pub trait BlockTest: Copy {
         best: &mut PacketBest,
         closest: bool,
     ) -> (u32, u64);
+
+    /// [`PacketTriRays::shared_axes`], with the test's instruction set.
+    ///
+    /// # Safety
+    /// As [`BlockTest::block`].
+    #[inline(always)]
+    unsafe fn shared_axes(packet: &PacketRays, active: u32) -> Option<[usize; 3]> {
+        PacketTriRays::shared_axes(packet, active)
+    }
 }
 
 /// The test with AVX-512: the sixteen rays in one vector.
@@ -188,6 +197,12 @@ impl BlockTest for Avx512Block {
         // SAFETY: the caller's guarantee: AVX-512.
         unsafe { block_avx512(block, packet, r, rays, best, closest) }
     }
+
+    #[inline(always)]
+    unsafe fn shared_axes(packet: &PacketRays, active: u32) -> Option<[usize; 3]> {
+        // SAFETY: the caller's guarantee: AVX-512.
+        unsafe { shared_axes_avx512(packet, active) }
+    }
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -209,7 +224,7 @@ impl BlockTest for Avx2Block {
 }
 
 #[cfg(target_arch = "x86_64")]
-pub use x86::{block_avx2, block_avx512};
+pub use x86::{block_avx2, block_avx512, shared_axes_avx512};
 
 #[cfg(target_arch = "x86_64")]
 mod x86 {
@@ -217,6 +232,42 @@ mod x86 {
 
     use super::super::triangles::{LANES, TriBlock, UNUSED};
     use super::{PacketBest, PacketRays, PacketTriRays};
+    use crate::Vec3;
+    use crate::shapes::WatertightRay;
+
+    /// [`PacketTriRays::shared_axes`] sixteen lanes at once: each lane's largest direction
+    /// component (the first of equal ones, in the order x, y, z) and its sign as masks, the same
+    /// comparisons as the portable form's (a NaN compares false in both).
+    ///
+    /// # Safety
+    /// The processor has AVX-512 F; the caller should be compiled with it.
+    #[inline(always)]
+    pub unsafe fn shared_axes_avx512(packet: &PacketRays, active: u32) -> Option<[usize; 3]> {
+        if active == 0 {
+            return None;
+        }
+        // SAFETY: the caller's guarantee; the rows are 64 bytes aligned to 64.
+        unsafe {
+            // No `map` over arrays: it compiled to a call.
+            let load = |a: usize| _mm512_load_ps(packet.dir[a].0.as_ptr());
+            let (dx, dy, dz) = (load(0), load(1), load(2));
+            let (ax, ay, az) = (_mm512_abs_ps(dx), _mm512_abs_ps(dy), _mm512_abs_ps(dz));
+            let ge = |a: __m512, b: __m512| _mm512_cmp_ps_mask::<_CMP_GE_OQ>(a, b);
+            let below = |v: __m512| _mm512_cmp_ps_mask::<_CMP_LT_OQ>(v, _mm512_setzero_ps());
+            let x_largest = ge(ax, ay) & ge(ax, az);
+            let y_largest = !x_largest & ge(ay, az);
+            let z_largest = !(x_largest | y_largest);
+            let down = (x_largest & below(dx)) | (y_largest & below(dy)) | (z_largest & below(dz));
+            // Every active lane as the first: each mask all set or all clear over them.
+            let (lanes, first) = (active as u16, active.trailing_zeros() as usize);
+            let same = |m: u16| m & lanes == 0 || m & lanes == lanes;
+            if !(same(x_largest) && same(y_largest) && same(down)) {
+                return None;
+            }
+            let at = |a: usize| packet.dir[a].0[first];
+            Some(WatertightRay::axes_of(Vec3::new(at(0), at(1), at(2))))
+        }
+    }
     use crate::geom::aabb::ROBUST_FAR_SCALE;
 
     /// Tests the rays of `rays` (bits of the packet `packet`, whose shared-axes constants are

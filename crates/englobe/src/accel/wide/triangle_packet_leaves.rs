@@ -148,7 +148,8 @@ impl<B: BlockTest> TrianglePacket<'_, WholePacket<B>> {
             return unsafe { self.test_blocks_each(first, count, rays, closest, counters) };
         }
         if self.test.tri.is_none() {
-            match PacketTriRays::shared_axes(self.packet, self.test.active) {
+            // SAFETY: the caller's guarantee: `B`'s instruction set.
+            match unsafe { B::shared_axes(self.packet, self.test.active) } {
                 Some(axes) => self.test.tri = Some(PacketTriRays::new(self.packet, self.test.active, axes)),
                 None => return self.give_up(),
             }
