@@ -235,6 +235,7 @@ mod x86 {
     use super::super::triangles::{LANES, TriBlock, UNUSED};
     use super::{PacketBest, PacketRays, PacketTriRays};
     use crate::Vec3;
+    use crate::geom::aabb::ROBUST_FAR_SCALE;
     use crate::shapes::WatertightRay;
 
     /// [`PacketTriRays::shared_axes`] sixteen lanes at once: each lane's largest direction
@@ -270,7 +271,6 @@ mod x86 {
             Some(WatertightRay::axes_of(Vec3::new(at(0), at(1), at(2))))
         }
     }
-    use crate::geom::aabb::ROBUST_FAR_SCALE;
 
     /// Tests the rays of `rays` (bits of the packet `packet`, whose shared-axes constants are
     /// `r`) against every used triangle of `block`. With `closest`, keeps each ray's closest hit
@@ -317,7 +317,8 @@ mod x86 {
             // The rays' rows the correction reads, and the lanes going up each axis, once per block.
             let inv = [load(&packet.inv_dir[0]), load(&packet.inv_dir[1]), load(&packet.inv_dir[2])];
             let origin = [load(&packet.origin[0]), load(&packet.origin[1]), load(&packet.origin[2])];
-            let up = inv.map(|inv| _mm512_cmp_ps_mask::<_CMP_GE_OQ>(inv, zero));
+            let going_up = |inv: __m512| _mm512_cmp_ps_mask::<_CMP_GE_OQ>(inv, zero);
+            let up = [going_up(inv[0]), going_up(inv[1]), going_up(inv[2])];
             for lane in 0..LANES {
                 let id = block.ids[lane];
                 if id == UNUSED {
