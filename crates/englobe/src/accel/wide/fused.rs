@@ -185,8 +185,8 @@ pub fn child_distances_fused_scalar(
     planes: &FusedPlanes,
     limit: f32,
 ) -> (f32, f32) {
-    let near = |a: usize| node.row(ray.row_index(a, 0))[slot].mul_add(ray.inv_dir[a], planes.near[a]);
-    let far = |a: usize| node.row(ray.row_index(a, 1))[slot].mul_add(ray.inv_far[a], planes.far[a]);
+    let near = |a: usize| node.bounds[ray.row_index(a, 0)][slot].mul_add(ray.inv_dir[a], planes.near[a]);
+    let far = |a: usize| node.bounds[ray.row_index(a, 1)][slot].mul_add(ray.inv_far[a], planes.far[a]);
     let enter = greater(greater(near(0), near(1)), greater(near(2), ray.t_min));
     let exit = less(less(far(0), far(1)), less(far(2), limit));
     (enter, exit)

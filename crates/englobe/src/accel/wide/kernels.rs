@@ -79,7 +79,7 @@ fn portable_slabs<const EXITS: bool>(node: &WideNode, ray: &NodeRay, limit: f32,
     {
         let mut mask = 0;
         for half in 0..2 {
-            let row = |r: usize| Vec4::from_slice(&node.row(r)[4 * half..4 * half + 4]);
+            let row = |r: usize| Vec4::from_slice(&node.bounds[r][4 * half..4 * half + 4]);
             let (mut enter, mut exit) = (Vec4::splat(ray.t_min), Vec4::splat(limit));
             for a in 0..3 {
                 let (o, inv) = (Vec4::splat(ray.origin[a]), Vec4::splat(-ray.inv_dir[a]));
@@ -304,7 +304,7 @@ mod tests {
         for slot in (0..WIDTH).filter(|&slot| mask >> slot & 1 != 0) {
             let mut exit = limit;
             for a in 0..3 {
-                let t_far = (r.origin[a] - node.row(r.row_index(a, 1))[slot]) * -r.inv_far[a];
+                let t_far = (r.origin[a] - node.bounds[r.row_index(a, 1)][slot]) * -r.inv_far[a];
                 exit = if t_far < exit { t_far } else { exit };
             }
             assert_eq!(exits[slot].to_bits(), exit.to_bits(), "{isa}: slot {slot} of {node:?}, {ray:?}");

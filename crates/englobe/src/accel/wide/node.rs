@@ -27,82 +27,44 @@ pub const EMPTY: u32 = u32::MAX;
 /// Most items one leaf reference can hold (its count is a byte).
 pub const MAX_LEAF_ITEMS: usize = u8::MAX as usize;
 
-/// Logical rows of a node's planes ([`WideNode::row`]): lower x, upper x, lower y, upper y, lower
-/// z, upper z; row `2 * axis + side`, side 0 the lower planes and 1 the upper.
+/// Rows of [`WideNode::bounds`]: lower x, upper x, lower y, upper y, lower z, upper z.
 pub const ROWS: usize = 6;
 
-/// One node: eight children's boxes (one row of eight floats per plane, column = child slot) and
-/// references.
-///
-/// The rows lie lower x, lower y, lower z, then the references, then upper x, upper y, upper z,
-/// then the leaf counts: each of the node's four cache lines holds a row that every node test
-/// reads, so the references and counts, which the walk reads only once the test has chosen a
-/// child, arrive with the planes rather than in a line of their own fetched after the test.
+/// One node: eight children's boxes (row `2 * axis` the lower planes, `2 * axis + 1` the upper
+/// planes, column = child slot) and references.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[repr(C, align(64))]
 pub struct WideNode {
-    /// The lower planes of x, y and z (rows 0, 2 and 4).
-    lower: [[f32; WIDTH]; 3],
+    /// The children's planes, one row of eight per plane (see [`ROWS`]).
+    pub bounds: [[f32; WIDTH]; ROWS],
     /// The children: an interior node's index, [`LEAF`] plus a first item, or [`EMPTY`].
     pub children: [u32; WIDTH],
-    /// The upper planes of x, y and z (rows 1, 3 and 5).
-    upper: [[f32; WIDTH]; 3],
     /// Items of each leaf child (0 for interior and empty slots).
     pub counts: [u8; WIDTH],
 }
 
 const _: () = assert!(std::mem::size_of::<WideNode>() == 256);
 
-/// Bytes of one row of planes.
-const ROW_BYTES: usize = WIDTH * 4;
-
-/// Bytes from a lower row to the upper row of the same axis: a power of two above every lower
-/// row's offset, so that flipping one bit of an offset goes from one side to the other.
-const SIDE_BYTES: usize = std::mem::offset_of!(WideNode, upper);
-const _: () = assert!(SIDE_BYTES.is_power_of_two() && SIDE_BYTES >= 3 * ROW_BYTES);
-const _: () = assert!(std::mem::offset_of!(WideNode, lower) == 0);
-
-/// Byte offset of row `r` (any `r`; a row of the node when `r < ROWS`).
-#[inline(always)]
-const fn row_bytes_of(r: usize) -> usize {
-    (r >> 1) * ROW_BYTES + (r & 1) * SIDE_BYTES
-}
-
 impl WideNode {
     /// A node with every slot empty.
     pub const EMPTY_NODE: WideNode = WideNode {
-        lower: [[f32::INFINITY; WIDTH]; 3],
+        bounds: [
+            [f32::INFINITY; WIDTH],
+            [f32::NEG_INFINITY; WIDTH],
+            [f32::INFINITY; WIDTH],
+            [f32::NEG_INFINITY; WIDTH],
+            [f32::INFINITY; WIDTH],
+            [f32::NEG_INFINITY; WIDTH],
+        ],
         children: [EMPTY; WIDTH],
-        upper: [[f32::NEG_INFINITY; WIDTH]; 3],
         counts: [0; WIDTH],
     };
-
-    /// Row `r` of planes: `2 * axis` the lower planes of `axis`, `2 * axis + 1` the upper.
-    ///
-    /// # Panics
-    /// If `r >= ROWS`.
-    #[inline(always)]
-    pub fn row(&self, r: usize) -> &[f32; WIDTH] {
-        let side = if r & 1 == 0 { &self.lower } else { &self.upper };
-        &side[r >> 1]
-    }
-
-    /// [`WideNode::row`] without the check of `r`, for kernels that load rows by offset.
-    ///
-    /// # Safety
-    /// `r < ROWS`.
-    #[inline(always)]
-    pub unsafe fn row_unchecked(&self, r: usize) -> &[f32; WIDTH] {
-        debug_assert!(r < ROWS);
-        // SAFETY: the caller's guarantee: the offset is that of a row inside the node.
-        unsafe { &*((self as *const WideNode as *const u8).add(row_bytes_of(r)) as *const [f32; WIDTH]) }
-    }
 
     /// Puts a child in slot `slot`: its box, its reference, and its item count (leaves only).
     pub fn set_child(&mut self, slot: usize, bounds: &Aabb, reference: u32, count: u8) {
         for axis in 0..3 {
-            self.lower[axis][slot] = bounds.min[axis];
-            self.upper[axis][slot] = bounds.max[axis];
+            self.bounds[2 * axis][slot] = bounds.min[axis];
+            self.bounds[2 * axis + 1][slot] = bounds.max[axis];
         }
         self.children[slot] = reference;
         self.counts[slot] = count;
@@ -110,10 +72,10 @@ impl WideNode {
 
     /// The box of slot `slot` (the empty box for an unused slot).
     pub fn child_bounds(&self, slot: usize) -> Aabb {
-        let (lo, hi) = (&self.lower, &self.upper);
+        let b = &self.bounds;
         Aabb::new(
-            glam::Vec3::new(lo[0][slot], lo[1][slot], lo[2][slot]),
-            glam::Vec3::new(hi[0][slot], hi[1][slot], hi[2][slot]),
+            glam::Vec3::new(b[0][slot], b[2][slot], b[4][slot]),
+            glam::Vec3::new(b[1][slot], b[3][slot], b[5][slot]),
         )
     }
 
@@ -150,11 +112,11 @@ pub struct NodeRay {
     pub inv_far: [f32; 3],
     /// The ray's `t_min`.
     pub t_min: f32,
-    /// Byte offset in a [`WideNode`] of the near row of each axis, for kernels that load rows
-    /// without an index check; the far row is the axis's other one, at `near ^ SIDE_BYTES` (a
-    /// lower row and the upper row of its axis differ in that bit alone), so that a query makes
-    /// three offsets rather than six. Private, so that only [`NodeRay::new`] makes them, each
-    /// the offset of a row.
+    /// Byte offset of the near row of each axis in [`WideNode::bounds`], for kernels that load
+    /// rows without an index check; the far row is the axis's other one, at `near ^ ROW_BYTES`
+    /// (rows `2a` and `2a + 1` differ in that bit alone), so that a query makes three offsets
+    /// rather than six. Private, so that only [`NodeRay::new`] makes them, always below
+    /// `ROWS * WIDTH * 4`.
     ///
     /// Each a `usize`, not a `u32`: the walk loads them one by one, and the compiler has been
     /// seen to join the loads of two adjacent `u32`s into one, which then spans two of the
@@ -170,6 +132,9 @@ pub struct NodeRay {
 pub const FAR_SCALE: f32 = 1.0 + 1.0 / (1 << 19) as f32;
 const _: () = assert!(FAR_SCALE >= ROBUST_FAR_SCALE);
 
+/// Bytes of one row of [`WideNode::bounds`].
+const ROW_BYTES: usize = WIDTH * 4;
+const _: () = assert!(ROW_BYTES.is_power_of_two(), "the far row is found by flipping one bit");
 
 impl NodeRay {
     /// Prepares `ray`.
@@ -179,7 +144,7 @@ impl NodeRay {
         // Bit `a` set if the ray goes down axis `a` (`!(inv >= 0)`, as the scalar slab test
         // decides it; the inverse of a zero component is `+inf`, never `-inf`).
         let down = inv.cmplt(glam::Vec3::ZERO).bitmask();
-        let near = |a: usize| row_bytes_of(2 * a + ((down as usize >> a) & 1));
+        let near = |a: usize| (2 * a + ((down as usize >> a) & 1)) * ROW_BYTES;
         NodeRay {
             origin: ray.origin().to_array(),
             inv_dir: inv.to_array(),
@@ -190,16 +155,16 @@ impl NodeRay {
     }
 
     /// Byte offset of the near (`side` 0) or far (`side` 1) row of `axis` (only the lowest bit of
-    /// `side` counts, so that the offset stays a row's whatever it is).
+    /// `side` counts, so that the offset stays within `bounds` whatever it is).
     #[inline(always)]
     fn row_offset(&self, axis: usize, side: usize) -> usize {
-        self.row_bytes[axis] ^ ((side & 1) * SIDE_BYTES)
+        self.row_bytes[axis] ^ ((side & 1) * ROW_BYTES)
     }
 
-    /// Row of the near (`side` 0) or far (`side` 1) plane of `axis` ([`WideNode::row`]'s index).
+    /// Row of the near (`side` 0) or far (`side` 1) plane of `axis` in [`WideNode::bounds`].
     #[inline(always)]
     pub fn row_index(&self, axis: usize, side: usize) -> usize {
-        2 * axis + self.row_offset(axis, side) / SIDE_BYTES
+        self.row_offset(axis, side) / ROW_BYTES
     }
 }
 
@@ -209,10 +174,10 @@ impl NodeRay {
     pub fn row<'a>(&self, node: &'a WideNode, axis: usize, side: usize) -> &'a [f32; WIDTH] {
         debug_assert!(axis < 3 && side < 2);
         let offset = self.row_offset(axis, side);
-        // SAFETY: `NodeRay::new`, the only maker of `row_bytes`, gives each the offset of a row of
-        // the node (`row_bytes_of`, row < ROWS), and `row_offset` at most flips it to the other
-        // row of the same axis; rows are arrays of WIDTH floats.
-        unsafe { &*((node as *const WideNode as *const u8).add(offset) as *const [f32; WIDTH]) }
+        // SAFETY: `NodeRay::new`, the only maker of `row_bytes`, gives each the start of a row of
+        // `bounds` (row < ROWS), a multiple of a row's size, and `row_offset` at most flips it to
+        // the other row of the same axis; rows are arrays of WIDTH floats.
+        unsafe { &*((node.bounds.as_ptr() as *const u8).add(offset) as *const [f32; WIDTH]) }
     }
 }
 
@@ -267,8 +232,8 @@ pub fn may_enter(bounds: &Aabb, ray: &Ray, limit: f32) -> bool {
 pub fn child_entry_scalar(node: &WideNode, slot: usize, ray: &NodeRay, limit: f32) -> Option<f32> {
     let (mut enter, mut exit) = (ray.t_min, limit);
     for a in 0..3 {
-        let t_near = (ray.origin[a] - node.row(ray.row_index(a, 0))[slot]) * -ray.inv_dir[a];
-        let t_far = (ray.origin[a] - node.row(ray.row_index(a, 1))[slot]) * -ray.inv_far[a];
+        let t_near = (ray.origin[a] - node.bounds[ray.row_index(a, 0)][slot]) * -ray.inv_dir[a];
+        let t_far = (ray.origin[a] - node.bounds[ray.row_index(a, 1)][slot]) * -ray.inv_far[a];
         enter = if t_near > enter { t_near } else { enter };
         exit = if t_far < exit { t_far } else { exit };
     }

@@ -35,7 +35,7 @@ use crate::Ray;
 /// The bounds of a packet's rays for the interval test of a node's children.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PacketInterval {
-    /// Row of each axis's near planes ([`WideNode::row`]: `2 * axis`, plus 1 if the rays go
+    /// Row of each axis's near planes in [`WideNode::bounds`] (`2 * axis`, plus 1 if the rays go
     /// down the axis); the far planes are the axis's other row. Below [`ROWS`].
     near_row: [usize; 3],
     /// Per axis, the origin coordinate that makes `near - o` least towards the boxes (the largest
@@ -103,8 +103,8 @@ impl PacketInterval {
         for slot in 0..WIDTH {
             let (mut enter, mut exit) = (self.t_min, f32::INFINITY);
             for a in 0..3 {
-                let x = node.row(self.near_row[a])[slot] - self.near_origin[a];
-                let xf = node.row(self.near_row[a] ^ 1)[slot] - self.far_origin[a];
+                let x = node.bounds[self.near_row[a]][slot] - self.near_origin[a];
+                let xf = node.bounds[self.near_row[a] ^ 1][slot] - self.far_origin[a];
                 enter = enter.max((x * self.inv[a][0]).min(x * self.inv[a][1]));
                 exit = exit.min((xf * self.inv_far[a][0]).max(xf * self.inv_far[a][1]));
             }
@@ -128,8 +128,8 @@ impl PacketInterval {
             let mut enter = _mm256_set1_ps(self.t_min);
             let mut exit = _mm256_set1_ps(f32::INFINITY);
             for a in 0..3 {
-                let near = _mm256_load_ps(node.row_unchecked(self.near_row[a]).as_ptr());
-                let far = _mm256_load_ps(node.row_unchecked(self.near_row[a] ^ 1).as_ptr());
+                let near = _mm256_load_ps(node.bounds.get_unchecked(self.near_row[a]).as_ptr());
+                let far = _mm256_load_ps(node.bounds.get_unchecked(self.near_row[a] ^ 1).as_ptr());
                 let x = _mm256_sub_ps(near, _mm256_set1_ps(self.near_origin[a]));
                 let xf = _mm256_sub_ps(far, _mm256_set1_ps(self.far_origin[a]));
                 let lower = _mm256_min_ps(

@@ -94,8 +94,8 @@ impl PacketKernel for ScalarPacket {
                         let down = (rays.down[a] >> i & 1) as usize;
                         let (near_row, far_row) = (2 * a + down, 2 * a + 1 - down);
                         let o = rays.origin[a].0[i];
-                        let t_near = (o - node.row(near_row)[c]) * -rays.inv_dir[a].0[i];
-                        let t_far = (o - node.row(far_row)[c]) * -rays.inv_far[a].0[i];
+                        let t_near = (o - node.bounds[near_row][c]) * -rays.inv_dir[a].0[i];
+                        let t_far = (o - node.bounds[far_row][c]) * -rays.inv_far[a].0[i];
                         enter = if t_near > enter { t_near } else { enter };
                         exit = if t_far < exit { t_far } else { exit };
                     }
@@ -191,15 +191,15 @@ mod x86 {
                     let (mut enter, mut exit) = (t_min, lim);
                     for a in 0..3 {
                         let (t_near, t_far) = if same_way {
-                            let near = _mm512_set1_ps(node.row(2 * a + rows[a])[c]);
-                            let far = _mm512_set1_ps(node.row(2 * a + 1 - rows[a])[c]);
+                            let near = _mm512_set1_ps(node.bounds[2 * a + rows[a]][c]);
+                            let far = _mm512_set1_ps(node.bounds[2 * a + 1 - rows[a]][c]);
                             (
                                 _mm512_mul_ps(_mm512_sub_ps(o[a], near), inv[a]),
                                 _mm512_mul_ps(_mm512_sub_ps(o[a], far), inv_far[a]),
                             )
                         } else {
-                            let lo = _mm512_sub_ps(o[a], _mm512_set1_ps(node.row(2 * a)[c]));
-                            let hi = _mm512_sub_ps(o[a], _mm512_set1_ps(node.row(2 * a + 1)[c]));
+                            let lo = _mm512_sub_ps(o[a], _mm512_set1_ps(node.bounds[2 * a][c]));
+                            let hi = _mm512_sub_ps(o[a], _mm512_set1_ps(node.bounds[2 * a + 1][c]));
                             // The lanes going down take the upper plane as the near one.
                             (
                                 _mm512_mul_ps(_mm512_mask_blend_ps(down[a], lo, hi), inv[a]),
@@ -281,8 +281,8 @@ mod x86 {
                         left &= left - 1;
                         let (mut enter, mut exit) = (t_min, lim);
                         for a in 0..3 {
-                            let lo = _mm256_sub_ps(o[a], _mm256_set1_ps(node.row(2 * a)[c]));
-                            let hi = _mm256_sub_ps(o[a], _mm256_set1_ps(node.row(2 * a + 1)[c]));
+                            let lo = _mm256_sub_ps(o[a], _mm256_set1_ps(node.bounds[2 * a][c]));
+                            let hi = _mm256_sub_ps(o[a], _mm256_set1_ps(node.bounds[2 * a + 1][c]));
                             let t_near = _mm256_mul_ps(_mm256_blendv_ps(lo, hi, down[a]), inv[a]);
                             let t_far = _mm256_mul_ps(_mm256_blendv_ps(hi, lo, down[a]), inv_far[a]);
                             enter = _mm256_max_ps(t_near, enter);
