@@ -401,9 +401,12 @@ pub unsafe fn any<K: NodeKernel, C: Counters, L: Leaves<C>>(
                     // module documentation), the others pushed as they come; each asked for as
                     // it is met (see `prefetch_children_of`), unless it is the only one.
                     let mut farthest = take_lowest(&mut mask);
-                    let several = mask != 0;
+                    if mask != 0 {
+                        prefetch_child(nodes, node.children[farthest], |first| leaves.prefetch(first));
+                    }
                     while mask != 0 {
                         let i = take_lowest(&mut mask);
+                        prefetch_child(nodes, node.children[i], |first| leaves.prefetch(first));
                         // Selected, not branched on: which child reaches farther is a coin toss.
                         let further = dist[i] > dist[farthest];
                         let push = std::hint::select_unpredictable(further, farthest, i);
@@ -414,9 +417,6 @@ pub unsafe fn any<K: NodeKernel, C: Counters, L: Leaves<C>>(
                             t: 0.0,
                         });
                         len += 1;
-                    }
-                    if several {
-                        prefetch_child(nodes, node.children[farthest], |first| leaves.prefetch(first));
                     }
                     current = Entry { reference: node.children[farthest], count: node.counts[farthest] as u32, t: 0.0 };
                     continue;
