@@ -49,7 +49,6 @@ pub mod fused;
 pub mod isa;
 pub mod kernels;
 pub mod node;
-pub mod occlusion_order;
 pub mod output;
 pub mod packet;
 pub mod packet_interval;

@@ -41,8 +41,6 @@ pub struct WideNode {
     pub children: [u32; WIDTH],
     /// Items of each leaf child (0 for interior and empty slots).
     pub counts: [u8; WIDTH],
-    /// Experiment: occlusion weight per child (upper half of an f32).
-    pub weights: [u16; WIDTH],
 }
 
 const _: () = assert!(std::mem::size_of::<WideNode>() == 256);
@@ -60,7 +58,6 @@ impl WideNode {
         ],
         children: [EMPTY; WIDTH],
         counts: [0; WIDTH],
-        weights: [0; WIDTH],
     };
 
     /// Puts a child in slot `slot`: its box, its reference, and its item count (leaves only).

@@ -356,12 +356,6 @@ pub unsafe fn closest<K: NodeKernel, C: Counters, L: Leaves<C>>(
     leaves.settle_closest();
 }
 
-/// Experiment: the exit times the child's chance of holding an occluder.
-#[inline(always)]
-fn key(node: &WideNode, i: usize, exits: &[f32; WIDTH]) -> f32 {
-    exits[i] * f32::from_bits((node.weights[i] as u32) << 16)
-}
-
 /// Whether any leaf item is hit, from node `start`: stops at the first one `leaves` reports.
 ///
 /// # Safety
@@ -414,7 +408,7 @@ pub unsafe fn any<K: NodeKernel, C: Counters, L: Leaves<C>>(
                         let i = take_lowest(&mut mask);
                         prefetch_child(nodes, node.children[i], |first| leaves.prefetch(first));
                         // Selected, not branched on: which child reaches farther is a coin toss.
-                        let further = key(node, i, &dist) > key(node, farthest, &dist);
+                        let further = dist[i] > dist[farthest];
                         let push = std::hint::select_unpredictable(further, farthest, i);
                         farthest = std::hint::select_unpredictable(further, i, farthest);
                         stack[len].write(Entry {

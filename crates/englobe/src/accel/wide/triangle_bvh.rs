@@ -14,7 +14,6 @@ use super::convert::{ConvertOptions, LeafSink};
 use super::dispatch;
 use super::isa::{Isa, IsaUnavailable};
 use super::node::{NodeRay, WideNode, may_enter, reach};
-use super::occlusion_order::{order_for_occlusion, triangle_chance};
 use super::presplit::{TriangleBox, presplit_cuts};
 use super::triangle_leaves;
 use super::triangles::{LANES, TriBlock, UNUSED, is_storable};
@@ -249,24 +248,8 @@ impl TriangleBvh {
             None => build_wide_refs(&options.builder, refs, options_wide, &mut sink),
         };
         let blocks = sink.fill(&triangle);
-        let mut nodes = layout.nodes;
-        if !nodes.is_empty() {
-            order_for_occlusion(&mut nodes, 0, &|first, count, bounds: &Aabb| {
-                let box_area = bounds.surface_area();
-                let mut missed = 1.0f32;
-                for block in &blocks[first as usize..(first + count) as usize] {
-                    for lane in 0..LANES {
-                        if block.ids[lane] != UNUSED {
-                            let [a, b, c] = block.vertices(lane);
-                            missed *= 1.0 - triangle_chance(0.5 * (b - a).cross(c - a).length(), box_area);
-                        }
-                    }
-                }
-                (1.0 - missed, count as f32)
-            });
-        }
         TriangleBvh {
-            nodes,
+            nodes: layout.nodes,
             blocks,
             depth: layout.depth,
             bounds,
