@@ -301,7 +301,11 @@ mod x86 {
             let load = |l: &super::Lanes| _mm512_load_ps(l.0.as_ptr());
             let [kx, ky, kz] = r.axes;
             let o_k = [load(&r.origin_k[0]), load(&r.origin_k[1]), load(&r.origin_k[2])];
-            let (sx, sy, sz) = (load(&r.shear[0]), load(&r.shear[1]), load(&r.shear[2]));
+            let (sx, sy) = (load(&r.shear[0]), load(&r.shear[1]));
+            let neg_sz = _mm512_castsi512_ps(_mm512_xor_si512(
+                _mm512_castps_si512(load(&r.shear[2])),
+                _mm512_set1_epi32(i32::MIN),
+            ));
             let zero = _mm512_setzero_ps();
             // The lanes holding a normal number, or a finite one, each class test one `vfpclassps`
             // (the same lanes as `MIN_POSITIVE <= |x| < inf` and `|x| < inf`): its categories are
@@ -325,13 +329,18 @@ mod x86 {
                     continue;
                 }
                 let at = |k: usize, axis: usize| block.v[3 * k + axis][lane];
-                // Vertex k relative to the origin, sheared: the block test's `ax`, `ay`, `az`.
+                // Vertex k relative to the origin, sheared: the block test's `ax`, `ay`, `az`,
+                // negated. Each difference is taken the other way round, `o - v`, so that the
+                // vertex is the value subtracted and its broadcast folds into the subtraction;
+                // rounding to nearest is symmetric, so every value is exactly the negation of the
+                // block test's, the edge functions (products of two of them) are its own bit for
+                // bit, and `az`, `bz`, `cz` are too, with the shear's `sz` negated (`neg_sz`).
                 // A macro rather than a closure: the closure, called three times, stayed a call.
                 macro_rules! project {
                     ($k:expr) => {{
-                        let x = _mm512_sub_ps(_mm512_set1_ps(at($k, kx)), o_k[0]);
-                        let y = _mm512_sub_ps(_mm512_set1_ps(at($k, ky)), o_k[1]);
-                        let z = _mm512_sub_ps(_mm512_set1_ps(at($k, kz)), o_k[2]);
+                        let x = _mm512_sub_ps(o_k[0], _mm512_set1_ps(at($k, kx)));
+                        let y = _mm512_sub_ps(o_k[1], _mm512_set1_ps(at($k, ky)));
+                        let z = _mm512_sub_ps(o_k[2], _mm512_set1_ps(at($k, kz)));
                         (_mm512_sub_ps(x, _mm512_mul_ps(sx, z)), _mm512_sub_ps(y, _mm512_mul_ps(sy, z)), z)
                     }};
                 }
@@ -353,7 +362,8 @@ mod x86 {
                 let mut special = inside & !all_normal;
                 let candidate = inside & all_normal;
                 if candidate != 0 {
-                    let (az, bz, cz) = (_mm512_mul_ps(sz, a_z), _mm512_mul_ps(sz, b_z), _mm512_mul_ps(sz, c_z));
+                    let (az, bz, cz) =
+                        (_mm512_mul_ps(neg_sz, a_z), _mm512_mul_ps(neg_sz, b_z), _mm512_mul_ps(neg_sz, c_z));
                     let det = _mm512_add_ps(_mm512_add_ps(e0, e1), e2);
                     let t_scaled = _mm512_add_ps(
                         _mm512_add_ps(_mm512_mul_ps(e0, az), _mm512_mul_ps(e1, bz)),
