@@ -8,10 +8,11 @@
 //!
 //! Each lane computes exactly what a lane of the single-ray block test
 //! ([`super::triangles::intersect_block`]) computes for its ray and triangle: the same arithmetic
-//! in the same order, no fused multiply-add, the same *special* cases left to the scalar test
-//! (found, with AVX-512, by one class test per value where the block test compares magnitudes:
-//! the same lanes). So every ray keeps the answer of its own query, as
-//! `englobe/tests/packet_blocks.rs` checks bit for bit.
+//! in the same order (but for the AVX-512 projection's differences, taken the other way round:
+//! exactly their negations, which change no value after them), no fused multiply-add, the same
+//! *special* cases left to the scalar test (found, with AVX-512, by one class test per value where
+//! the block test compares magnitudes: the same lanes). So every ray keeps the answer of its own
+//! query, as `englobe/tests/packet_blocks.rs` checks bit for bit.
 
 use super::packet_kernels::{Lanes, PACKET, PacketRays};
 #[cfg(target_arch = "x86_64")]
