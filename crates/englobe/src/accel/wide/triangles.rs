@@ -307,14 +307,10 @@ fn order(lo: Vec4, hi: Vec4, swap: BVec4A) -> (Vec4, Vec4) {
 #[inline(always)]
 pub fn intersect_block(block: &TriBlock, r: &TriRay, t_max: f32) -> Option<BlockHits> {
     let [sx, sy, sz] = r.shear;
-    // Vertex k relative to the origin, sheared: exactly the negations of the scalar test's `ax`,
-    // `ay`, `az`. The differences are taken the other way round, `o - v`, so that the block's row
-    // is the value subtracted and its load folds into the subtraction; rounding to nearest is
-    // symmetric, so each is the exact negation, the edge functions (products of two of them) are
-    // the scalar test's bit for bit, and so are `az`, `bz`, `cz` with `sz` negated.
+    // Vertex k relative to the origin, sheared: exactly the scalar test's `ax`, `ay`, `az`.
     let project = |k: usize| {
         let (x, y, z) =
-            (r.origin[0] - r.row(block, k, 0), r.origin[1] - r.row(block, k, 1), r.origin[2] - r.row(block, k, 2));
+            (r.row(block, k, 0) - r.origin[0], r.row(block, k, 1) - r.origin[1], r.row(block, k, 2) - r.origin[2]);
         (x - sx * z, y - sy * z, z)
     };
     let (ax, ay, a_z) = project(0);
@@ -344,8 +340,7 @@ pub fn intersect_block(block: &TriBlock, r: &TriRay, t_max: f32) -> Option<Block
     if !candidate.any() {
         return Some(BlockHits { special: special.bitmask(), ..BlockHits::NONE });
     }
-    let neg_sz = -sz;
-    let (az, bz, cz) = (neg_sz * a_z, neg_sz * b_z, neg_sz * c_z);
+    let (az, bz, cz) = (sz * a_z, sz * b_z, sz * c_z);
     let t_scaled = e0 * az + e1 * bz + e2 * cz;
     let inv_det = Vec4::ONE / det;
     let t = t_scaled * inv_det;
