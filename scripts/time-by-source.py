@@ -38,17 +38,21 @@ def main() -> int:
     data, binary, function = sys.argv[1:4]
     lines = int(sys.argv[4]) if len(sys.argv) == 5 else 30
     annotated = subprocess.run(
-        ["perf", "annotate", "-i", data, "--stdio", "--no-source", "-s", function],
+        ["perf", "annotate", "-i", data, "--stdio", "--no-source", "--show-nr-samples", "-s", function],
         capture_output=True, text=True, check=True,
     ).stdout
-    samples = []
+    # Sample counts, not perf's percentages: those are rounded to two decimals per instruction,
+    # and a thousand instructions of one or two samples each would add up to more than 100 %.
+    counts = []
     for line in annotated.splitlines():
-        m = re.match(r"\s+([0-9.]+)\s+:\s+([0-9a-f]+):", line)
+        m = re.match(r"\s+([0-9]+)\s+:\s+([0-9a-f]+):", line)
         if m:
-            samples.append((float(m.group(1)), int(m.group(2), 16)))
-    if not samples:
+            counts.append((int(m.group(1)), int(m.group(2), 16)))
+    total = sum(n for n, _ in counts)
+    if total == 0:
         print(f"no samples of {function} in {data}", file=sys.stderr)
         return 1
+    samples = [(100.0 * n / total, address) for n, address in counts if n]
     # `addr2line -i -a` prints each address, then its inline chain, innermost frame first.
     chains, current = {}, None
     out = subprocess.run(
