@@ -372,9 +372,9 @@ mod x86 {
                     );
                     let inv_det = _mm512_div_ps(_mm512_set1_ps(1.0), det);
                     let t = _mm512_mul_ps(t_scaled, inv_det);
-                    let finite = finite(t);
-                    special |= candidate & !finite;
-                    let candidate = candidate & finite;
+                    let t_finite = finite(t);
+                    special |= candidate & !t_finite;
+                    let candidate = candidate & t_finite;
                     // The box-stretch correction, as the block test computes it.
                     if !boxes_made {
                         for axis in 0..3 {
