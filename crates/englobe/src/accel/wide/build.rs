@@ -155,20 +155,7 @@ impl<S: Splitter> Builder<'_, S> {
             part,
             slots,
             |p| self.terminal(p),
-            |p| {
-                static MODE: std::sync::OnceLock<u32> = std::sync::OnceLock::new();
-                let mode = *MODE
-                    .get_or_init(|| std::env::var("ENGLOBE_GREEDY").ok().and_then(|v| v.parse().ok()).unwrap_or(0));
-                let a = p.bounds.surface_area();
-                let n = p.len() as f32;
-                let key = match mode {
-                    1 => a * n,
-                    2 => a * n.sqrt(),
-                    3 => a * n.ln_1p(),
-                    _ => a,
-                };
-                (key, p.len() as u32)
-            },
+            |p| (p.bounds.surface_area(), p.len() as u32),
             |p| self.open(refs, base, p, scratch),
         );
     }
