@@ -15,7 +15,7 @@ use super::dispatch::{self, RayQuery};
 use super::fused;
 use super::isa::Isa;
 use super::kernels::NodeKernel;
-use super::node::{NodeRay, WideNode, reach};
+use super::node::{NodeRay, WalkNode, WideNode, reach};
 use super::traverse;
 use super::triangle_bvh::TriangleBvh;
 use super::triangle_leaves::{self, AnyWalk, TriangleLeaves};
@@ -65,6 +65,11 @@ impl<C: Counters, F: HitFilter<Hit>> RayQuery for Any<'_, C, F> {
     }
 
     #[inline(always)]
+    fn compressed(&self) -> bool {
+        !self.bvh.qnodes.is_empty()
+    }
+
+    #[inline(always)]
     unsafe fn run<K: NodeKernel>(self, kernel: K) -> bool {
         let Any { bvh, ray, counters, filter } = self;
         debug_assert!(ray.is_valid() && !bvh.nodes().is_empty());
@@ -75,10 +80,11 @@ impl<C: Counters, F: HitFilter<Hit>> RayQuery for Any<'_, C, F> {
 }
 
 /// An any-hit walk of the whole tree with `kernel`, compiled into the query that makes it.
-struct TreeWalk<'a, K, C> {
+struct TreeWalk<'a, K: NodeKernel, C> {
     kernel: K,
     isa: Isa,
-    nodes: &'a [WideNode],
+    nodes: &'a [K::Node],
+    wide: &'a [WideNode],
     depth: u32,
     ray: NodeRay,
     /// Where a box may begin and still be entered by an any-hit walk.
@@ -97,7 +103,8 @@ impl<'a, K: NodeKernel, C: Counters> TreeWalk<'a, K, C> {
         TreeWalk {
             kernel,
             isa: bvh.isa(),
-            nodes: bvh.nodes(),
+            nodes: K::Node::in_tree(bvh),
+            wide: bvh.nodes(),
             depth: bvh.depth(),
             ray: NodeRay::new(ray),
             limit: reach(ray.t_max),
@@ -116,7 +123,7 @@ impl<F: HitFilter<Hit>, K: NodeKernel, C: Counters> AnyWalk<F> for TreeWalk<'_, 
 
     #[inline(always)]
     fn walk_again(&mut self, leaves: &mut TriangleLeaves<'_, F>) -> bool {
-        dispatch::any(self.isa, self.nodes, self.depth, 0, &self.ray, self.limit, leaves, self.counters)
+        dispatch::any(self.isa, self.wide, self.depth, 0, &self.ray, self.limit, leaves, self.counters)
     }
 }
 
