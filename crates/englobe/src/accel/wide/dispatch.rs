@@ -51,32 +51,6 @@ pub fn closest<C: Counters, L: Leaves<C>>(
     }
 }
 
-/// [`closest`] in a tree that may also have its nodes compressed (`compressed`, empty if not):
-/// the AVX-512 walk of a ray the fused test applies to takes them.
-#[inline(always)]
-#[allow(clippy::too_many_arguments)]
-pub fn closest_compressed<C: Counters, L: Leaves<C>>(
-    isa: Isa,
-    nodes: &[WideNode],
-    compressed: &[super::qnode::QNode],
-    depth: u32,
-    start: u32,
-    ray: &NodeRay,
-    leaves: &mut L,
-    counters: &mut C,
-) {
-    #[cfg(target_arch = "x86_64")]
-    if isa == Isa::Avx512 && !compressed.is_empty() && fused::applies_to(ray) {
-        debug_assert!(isa.is_available());
-        // SAFETY: the structure's instruction set is one the processor has (module
-        // documentation); the ray is one the fused test applies to.
-        unsafe { x86::closest_avx512(super::kernels::QUANT, compressed, depth, start, ray, leaves, counters) };
-        return;
-    }
-    let _ = compressed;
-    closest(isa, nodes, depth, start, ray, leaves, counters)
-}
-
 /// The any-hit traversal compiled for `isa` (see [`closest`]).
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
@@ -242,12 +216,6 @@ pub trait RayQuery {
     type Output;
     /// Whether the fused node test applies to the query's ray ([`super::fused::applies`]).
     fn fused(&self) -> bool;
-    /// Whether the query's tree has compressed nodes ([`super::qnode`]), which the fused walk
-    /// then takes. None by default.
-    #[inline(always)]
-    fn compressed(&self) -> bool {
-        false
-    }
     /// Runs the query with `kernel`. Implementations are `#[inline(always)]`, so that their body
     /// is compiled into the copy that calls them.
     ///
@@ -266,11 +234,6 @@ pub fn ray_query<Q: RayQuery>(isa: Isa, query: Q) -> Q::Output {
         // SAFETY: the structure's instruction set is one the processor has (module documentation).
         #[cfg(target_arch = "x86_64")]
         Isa::Avx2 => unsafe { x86::ray_query_avx2(query) },
-        // SAFETY: as above.
-        #[cfg(target_arch = "x86_64")]
-        Isa::Avx512 if query.fused() && query.compressed() => unsafe {
-            x86::ray_query_avx512(super::kernels::QUANT, query)
-        },
         // SAFETY: as above.
         #[cfg(target_arch = "x86_64")]
         Isa::Avx512 if query.fused() => unsafe { x86::ray_query_avx512(x86::FUSED, query) },
@@ -414,7 +377,7 @@ mod x86 {
     #[target_feature(enable = "avx2,fma,bmi1,bmi2,lzcnt,popcnt,avx512f,avx512vl,avx512bw,avx512dq")]
     pub unsafe fn closest_avx512<K: NodeKernel, C: Counters, L: Leaves<C>>(
         kernel: K,
-        nodes: &[K::Node],
+        nodes: &[WideNode],
         depth: u32,
         start: u32,
         ray: &NodeRay,
@@ -447,7 +410,7 @@ mod x86 {
     #[allow(clippy::too_many_arguments)]
     pub unsafe fn any_avx512<K: NodeKernel, C: Counters, L: Leaves<C>>(
         kernel: K,
-        nodes: &[K::Node],
+        nodes: &[WideNode],
         depth: u32,
         start: u32,
         ray: &NodeRay,

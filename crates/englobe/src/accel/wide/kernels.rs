@@ -18,13 +18,10 @@
 
 use glam::Vec4;
 
-use super::node::{NodeRay, WIDTH, WalkNode, WideNode};
+use super::node::{NodeRay, WIDTH, WideNode};
 
 /// A slab test of all children of a node.
 pub trait NodeKernel: Copy {
-    /// The nodes the kernel tests.
-    type Node: WalkNode;
-
     /// Whether the processor that runs this kernel has AVX (the x86 kernels say so): code
     /// compiled with the kernel's target features may then use it, as the triangle test's set-up
     /// does ([`super::triangles::TriRay::new_avx`]). False unless a kernel says so.
@@ -48,7 +45,7 @@ pub trait NodeKernel: Copy {
     /// # Safety
     /// The caller is compiled with the kernel's target features and runs on a processor that
     /// has them.
-    unsafe fn children(self, node: &Self::Node, ray: &NodeRay, limit: f32, dist: &mut [f32; WIDTH]) -> u32;
+    unsafe fn children(self, node: &WideNode, ray: &NodeRay, limit: f32, dist: &mut [f32; WIDTH]) -> u32;
 
     /// The same test, with `dist[i]` the distance at which the ray leaves child `i` (its exit,
     /// within `limit`) instead of the one at which it enters: what occlusion walks order the
@@ -56,7 +53,7 @@ pub trait NodeKernel: Copy {
     ///
     /// # Safety
     /// As [`NodeKernel::children`].
-    unsafe fn children_exits(self, node: &Self::Node, ray: &NodeRay, limit: f32, dist: &mut [f32; WIDTH]) -> u32;
+    unsafe fn children_exits(self, node: &WideNode, ray: &NodeRay, limit: f32, dist: &mut [f32; WIDTH]) -> u32;
 }
 
 /// Four lanes at a time through glam (SSE2 on x86-64, NEON on aarch64, scalar elsewhere).
@@ -64,8 +61,6 @@ pub trait NodeKernel: Copy {
 pub struct Portable;
 
 impl NodeKernel for Portable {
-    type Node = WideNode;
-
     #[inline(always)]
     unsafe fn children(self, node: &WideNode, ray: &NodeRay, limit: f32, dist: &mut [f32; WIDTH]) -> u32 {
         portable_slabs::<false>(node, ray, limit, dist)
@@ -101,14 +96,13 @@ fn portable_slabs<const EXITS: bool>(node: &WideNode, ray: &NodeRay, limit: f32,
 }
 
 #[cfg(target_arch = "x86_64")]
-pub use x86::{Avx2, Avx512, Avx512Fused, Avx512Quant, QUANT};
+pub use x86::{Avx2, Avx512, Avx512Fused};
 
 #[cfg(target_arch = "x86_64")]
 mod x86 {
     use std::arch::x86_64::*;
 
     use super::super::fused::FusedPlanes;
-    use super::super::qnode::QNode;
     use super::{NodeKernel, NodeRay, WIDTH, WideNode};
 
     /// Eight lanes with AVX2.
@@ -143,8 +137,6 @@ mod x86 {
     }
 
     impl NodeKernel for Avx2 {
-        type Node = WideNode;
-
         const AVX: bool = true;
 
         #[inline(always)]
@@ -173,8 +165,6 @@ mod x86 {
     pub struct Avx512;
 
     impl NodeKernel for Avx512 {
-        type Node = WideNode;
-
         const AVX: bool = true;
 
         #[inline(always)]
@@ -230,8 +220,6 @@ mod x86 {
     pub struct Avx512Fused(pub FusedPlanes);
 
     impl NodeKernel for Avx512Fused {
-        type Node = WideNode;
-
         const AVX: bool = true;
 
         #[inline(always)]
@@ -258,78 +246,6 @@ mod x86 {
                 let (enter, exit) = slabs_fused(node, ray, &self.0, limit);
                 _mm256_storeu_ps(dist.as_mut_ptr(), exit);
                 _mm256_cmp_ps_mask::<_CMP_LE_OQ>(enter, exit) as u32
-            }
-        }
-    }
-
-    /// The fused node test ([`Avx512Fused`]) of a compressed node ([`QNode`]): each row's bytes
-    /// widened and decoded to planes, `origin + q * scale` (exact products, one rounding), then
-    /// tested as a [`WideNode`]'s rows are. For the rays the fused form applies to.
-    #[derive(Clone, Copy, Debug)]
-    pub struct Avx512Quant {
-        planes: FusedPlanes,
-        /// Byte offset of each axis's near row in [`QNode::q`] (the far row's is one row over).
-        rows: [usize; 3],
-    }
-
-    /// The compressed kernel as a walk takes it, its constants made at the walk's start.
-    pub const QUANT: Avx512Quant = Avx512Quant { planes: FusedPlanes::NONE, rows: [0, 16, 32] };
-
-    /// Entry and exit distances of the eight children of a compressed node.
-    #[inline(always)]
-    unsafe fn slabs_quant(node: &QNode, ray: &NodeRay, k: &Avx512Quant, limit: f32) -> (__m256, __m256) {
-        // SAFETY (for the whole function): the caller guarantees AVX2 and FMA; `rows` holds the
-        // offsets of rows of `q` (`row * 8`, row < 6, see `for_ray`), each eight bytes.
-        unsafe {
-            let base = node.q.as_ptr() as *const u8;
-            let (mut near, mut far) = ([_mm256_setzero_ps(); 3], [_mm256_setzero_ps(); 3]);
-            for a in 0..3 {
-                let row = |offset: usize| {
-                    _mm256_cvtepi32_ps(_mm256_cvtepu8_epi32(_mm_loadl_epi64(base.add(offset) as *const __m128i)))
-                };
-                let (lo, hi) = (row(k.rows[a]), row(k.rows[a] ^ WIDTH));
-                let (scale, origin) = (_mm256_set1_ps(node.scale[a]), _mm256_set1_ps(node.origin[a]));
-                let (lo, hi) = (_mm256_fmadd_ps(lo, scale, origin), _mm256_fmadd_ps(hi, scale, origin));
-                near[a] = _mm256_fmadd_ps(lo, _mm256_set1_ps(ray.inv_dir[a]), _mm256_set1_ps(k.planes.near[a]));
-                far[a] = _mm256_fmadd_ps(hi, _mm256_set1_ps(ray.inv_far[a]), _mm256_set1_ps(k.planes.far[a]));
-            }
-            let enter =
-                _mm256_max_ps(_mm256_max_ps(near[0], near[1]), _mm256_max_ps(near[2], _mm256_set1_ps(ray.t_min)));
-            let exit = _mm256_min_ps(_mm256_min_ps(far[0], far[1]), _mm256_min_ps(far[2], _mm256_set1_ps(limit)));
-            (enter, exit)
-        }
-    }
-
-    impl NodeKernel for Avx512Quant {
-        type Node = QNode;
-
-        const AVX: bool = true;
-
-        #[inline(always)]
-        unsafe fn for_ray(self, ray: &NodeRay) -> Self {
-            // SAFETY: the caller's guarantee: AVX-512 F and VL.
-            let planes = unsafe { FusedPlanes::new_avx512(ray) };
-            Avx512Quant { planes, rows: [0, 1, 2].map(|a| ray.row_index(a, 0) * WIDTH) }
-        }
-
-        #[inline(always)]
-        unsafe fn children(self, node: &QNode, ray: &NodeRay, limit: f32, dist: &mut [f32; WIDTH]) -> u32 {
-            // SAFETY: AVX-512 F and VL (and FMA) are guaranteed by the caller; `dist` holds eight
-            // floats.
-            unsafe {
-                let (enter, exit) = slabs_quant(node, ray, &self, limit);
-                _mm256_storeu_ps(dist.as_mut_ptr(), enter);
-                _mm256_mask_cmp_ps_mask::<_CMP_LE_OQ>(node.used, enter, exit) as u32
-            }
-        }
-
-        #[inline(always)]
-        unsafe fn children_exits(self, node: &QNode, ray: &NodeRay, limit: f32, dist: &mut [f32; WIDTH]) -> u32 {
-            // SAFETY: as in `children`.
-            unsafe {
-                let (enter, exit) = slabs_quant(node, ray, &self, limit);
-                _mm256_storeu_ps(dist.as_mut_ptr(), exit);
-                _mm256_mask_cmp_ps_mask::<_CMP_LE_OQ>(node.used, enter, exit) as u32
             }
         }
     }

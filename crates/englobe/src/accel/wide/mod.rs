@@ -59,7 +59,6 @@ pub mod packet_triangles;
 mod pieces;
 pub mod point_query;
 pub mod presplit;
-pub mod qnode;
 pub mod ray_packet;
 pub mod refit;
 pub mod traverse;

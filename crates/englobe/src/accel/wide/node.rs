@@ -85,34 +85,6 @@ impl WideNode {
     }
 }
 
-/// What a walk reads of a node besides its planes, whatever their form: a child's reference and
-/// item count.
-pub trait WalkNode: Sized {
-    /// The nodes of this form in `bvh`.
-    fn in_tree(bvh: &super::TriangleBvh) -> &[Self];
-    /// The reference in slot `slot`.
-    fn child(&self, slot: usize) -> u32;
-    /// The item count in slot `slot`.
-    fn count(&self, slot: usize) -> u32;
-}
-
-impl WalkNode for WideNode {
-    #[inline(always)]
-    fn in_tree(bvh: &super::TriangleBvh) -> &[Self] {
-        bvh.nodes()
-    }
-
-    #[inline(always)]
-    fn child(&self, slot: usize) -> u32 {
-        self.children[slot]
-    }
-
-    #[inline(always)]
-    fn count(&self, slot: usize) -> u32 {
-        self.counts[slot] as u32
-    }
-}
-
 /// Whether a child reference names a leaf (an unused slot's does too, but no ray reaches it).
 #[inline(always)]
 pub fn is_leaf(reference: u32) -> bool {

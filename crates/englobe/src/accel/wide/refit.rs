@@ -199,7 +199,6 @@ impl TriangleBvh {
             node_box[i] = all;
         }
         self.bounds = node_box.first().copied().unwrap_or(Aabb::EMPTY);
-        self.qnodes = super::qnode::compress(&self.nodes);
         self.built_sah_cost = Some(built_sah_cost);
         Ok(RefitReport { rebuilt: false, sah_cost: self.sah_cost(), built_sah_cost })
     }

@@ -36,7 +36,7 @@ use std::cell::Cell;
 use std::mem::MaybeUninit;
 
 use super::kernels::NodeKernel;
-use super::node::{NodeRay, WIDTH, WalkNode, index_of, is_leaf, reach};
+use super::node::{NodeRay, WIDTH, WideNode, index_of, is_leaf, reach};
 use crate::accel::Counters;
 use crate::geom::prefetch::prefetch;
 
@@ -93,19 +93,19 @@ pub trait Leaves<C: Counters> {
 /// miss to overlap with. (The single-ray walks ask for each child as they make its entry, in the
 /// loop over the mask they run anyway.)
 #[inline(always)]
-pub(super) fn prefetch_children_of<N: WalkNode>(nodes: &[N], node: &N, mut mask: u32, leaf: impl Fn(u32)) {
+pub(super) fn prefetch_children_of(nodes: &[WideNode], node: &WideNode, mut mask: u32, leaf: impl Fn(u32)) {
     if mask & mask.wrapping_sub(1) == 0 {
         return;
     }
     while mask != 0 {
         let i = take_lowest(&mut mask);
-        prefetch_child(nodes, node.child(i), &leaf);
+        prefetch_child(nodes, node.children[i], &leaf);
     }
 }
 
 /// Asks for one child: a node, or the first item of a leaf through `leaf`.
 #[inline(always)]
-fn prefetch_child<N>(nodes: &[N], child: u32, leaf: impl Fn(u32)) {
+fn prefetch_child(nodes: &[WideNode], child: u32, leaf: impl Fn(u32)) {
     if is_leaf(child) {
         leaf(index_of(child));
     } else {
@@ -117,16 +117,16 @@ fn prefetch_child<N>(nodes: &[N], child: u32, leaf: impl Fn(u32)) {
 /// [`prefetch_children_of`]) as it is made: [`closest`] makes one only when two children or more
 /// are entered, so that the loop over the mask is the one that makes the entries.
 #[inline(always)]
-fn asked_entry<N: WalkNode, C: Counters, L: Leaves<C>>(
-    nodes: &[N],
-    node: &N,
+fn asked_entry<C: Counters, L: Leaves<C>>(
+    nodes: &[WideNode],
+    node: &WideNode,
     slot: usize,
     dist: &[f32; WIDTH],
     leaves: &L,
 ) -> Entry {
-    let reference = node.child(slot);
+    let reference = node.children[slot];
     prefetch_child(nodes, reference, |first| leaves.prefetch(first));
-    Entry { reference, count: node.count(slot), t: dist[slot] }
+    Entry { reference, count: node.counts[slot] as u32, t: dist[slot] }
 }
 
 thread_local! {
@@ -219,7 +219,7 @@ fn farther_first(first: Entry, second: Entry) -> (Entry, Entry) {
 #[inline(always)]
 pub unsafe fn closest<K: NodeKernel, C: Counters, L: Leaves<C>>(
     kernel: K,
-    nodes: &[K::Node],
+    nodes: &[WideNode],
     depth: u32,
     start: u32,
     ray: &NodeRay,
@@ -256,7 +256,8 @@ pub unsafe fn closest<K: NodeKernel, C: Counters, L: Leaves<C>>(
                     let first = take_lowest(&mut mask);
                     if mask == 0 {
                         // A lone child is not asked for: it is read next.
-                        current = Entry { reference: node.child(first), count: node.count(first), t: dist[first] };
+                        current =
+                            Entry { reference: node.children[first], count: node.counts[first] as u32, t: dist[first] };
                         continue;
                     }
                     let a = asked_entry(nodes, node, first, &dist, leaves);
@@ -363,7 +364,7 @@ pub unsafe fn closest<K: NodeKernel, C: Counters, L: Leaves<C>>(
 #[allow(clippy::too_many_arguments)]
 pub unsafe fn any<K: NodeKernel, C: Counters, L: Leaves<C>>(
     kernel: K,
-    nodes: &[K::Node],
+    nodes: &[WideNode],
     depth: u32,
     start: u32,
     ray: &NodeRay,
@@ -401,19 +402,23 @@ pub unsafe fn any<K: NodeKernel, C: Counters, L: Leaves<C>>(
                     // it is met (see `prefetch_children_of`), unless it is the only one.
                     let mut farthest = take_lowest(&mut mask);
                     if mask != 0 {
-                        prefetch_child(nodes, node.child(farthest), |first| leaves.prefetch(first));
+                        prefetch_child(nodes, node.children[farthest], |first| leaves.prefetch(first));
                     }
                     while mask != 0 {
                         let i = take_lowest(&mut mask);
-                        prefetch_child(nodes, node.child(i), |first| leaves.prefetch(first));
+                        prefetch_child(nodes, node.children[i], |first| leaves.prefetch(first));
                         // Selected, not branched on: which child reaches farther is a coin toss.
                         let further = dist[i] > dist[farthest];
                         let push = std::hint::select_unpredictable(further, farthest, i);
                         farthest = std::hint::select_unpredictable(further, i, farthest);
-                        stack[len].write(Entry { reference: node.child(push), count: node.count(push), t: 0.0 });
+                        stack[len].write(Entry {
+                            reference: node.children[push],
+                            count: node.counts[push] as u32,
+                            t: 0.0,
+                        });
                         len += 1;
                     }
-                    current = Entry { reference: node.child(farthest), count: node.count(farthest), t: 0.0 };
+                    current = Entry { reference: node.children[farthest], count: node.counts[farthest] as u32, t: 0.0 };
                     continue;
                 }
             }

@@ -15,7 +15,6 @@ use super::dispatch;
 use super::isa::{Isa, IsaUnavailable};
 use super::node::{NodeRay, WideNode, may_enter, reach};
 use super::presplit::{TriangleBox, presplit_cuts};
-use super::qnode::{QNode, compress};
 use super::triangle_leaves;
 use super::triangles::{LANES, TriBlock, UNUSED, is_storable};
 use crate::accel::bvh::BinnedSah;
@@ -77,9 +76,6 @@ impl Default for TriangleBvhOptions {
 #[derive(Clone, Debug)]
 pub struct TriangleBvh {
     pub(super) nodes: Vec<WideNode>,
-    /// The nodes compressed ([`super::qnode`]), for the AVX-512 single-ray walks; empty if some
-    /// node has no grid.
-    pub(super) qnodes: Vec<QNode>,
     pub(super) blocks: Vec<TriBlock>,
     pub(super) depth: u32,
     pub(super) bounds: Aabb,
@@ -253,7 +249,6 @@ impl TriangleBvh {
         };
         let blocks = sink.fill(&triangle);
         TriangleBvh {
-            qnodes: compress(&layout.nodes),
             nodes: layout.nodes,
             blocks,
             depth: layout.depth,
@@ -361,16 +356,7 @@ impl TriangleBvh {
         }
         let node_ray = NodeRay::new(ray);
         triangle_leaves::closest_hit(&self.blocks, ray, ray.t_max, filter, |leaves| {
-            dispatch::closest_compressed(
-                self.isa,
-                &self.nodes,
-                &self.qnodes,
-                self.depth,
-                0,
-                &node_ray,
-                leaves,
-                counters,
-            )
+            dispatch::closest(self.isa, &self.nodes, self.depth, 0, &node_ray, leaves, counters)
         })
     }
 

@@ -15,7 +15,7 @@ use super::dispatch::{self, RayQuery};
 use super::fused;
 use super::isa::Isa;
 use super::kernels::NodeKernel;
-use super::node::{NodeRay, WalkNode, WideNode, reach};
+use super::node::{NodeRay, WideNode, reach};
 use super::traverse;
 use super::triangle_bvh::TriangleBvh;
 use super::triangle_leaves::{self, AnyWalk, TriangleLeaves};
@@ -65,11 +65,6 @@ impl<C: Counters, F: HitFilter<Hit>> RayQuery for Any<'_, C, F> {
     }
 
     #[inline(always)]
-    fn compressed(&self) -> bool {
-        !self.bvh.qnodes.is_empty()
-    }
-
-    #[inline(always)]
     unsafe fn run<K: NodeKernel>(self, kernel: K) -> bool {
         let Any { bvh, ray, counters, filter } = self;
         debug_assert!(ray.is_valid() && !bvh.nodes().is_empty());
@@ -80,11 +75,10 @@ impl<C: Counters, F: HitFilter<Hit>> RayQuery for Any<'_, C, F> {
 }
 
 /// An any-hit walk of the whole tree with `kernel`, compiled into the query that makes it.
-struct TreeWalk<'a, K: NodeKernel, C> {
+struct TreeWalk<'a, K, C> {
     kernel: K,
     isa: Isa,
-    nodes: &'a [K::Node],
-    wide: &'a [WideNode],
+    nodes: &'a [WideNode],
     depth: u32,
     ray: NodeRay,
     /// Where a box may begin and still be entered by an any-hit walk.
@@ -103,8 +97,7 @@ impl<'a, K: NodeKernel, C: Counters> TreeWalk<'a, K, C> {
         TreeWalk {
             kernel,
             isa: bvh.isa(),
-            nodes: K::Node::in_tree(bvh),
-            wide: bvh.nodes(),
+            nodes: bvh.nodes(),
             depth: bvh.depth(),
             ray: NodeRay::new(ray),
             limit: reach(ray.t_max),
@@ -123,7 +116,7 @@ impl<F: HitFilter<Hit>, K: NodeKernel, C: Counters> AnyWalk<F> for TreeWalk<'_, 
 
     #[inline(always)]
     fn walk_again(&mut self, leaves: &mut TriangleLeaves<'_, F>) -> bool {
-        dispatch::any(self.isa, self.wide, self.depth, 0, &self.ray, self.limit, leaves, self.counters)
+        dispatch::any(self.isa, self.nodes, self.depth, 0, &self.ray, self.limit, leaves, self.counters)
     }
 }
 
