@@ -54,17 +54,6 @@ pub trait NodeKernel: Copy {
     /// # Safety
     /// As [`NodeKernel::children`].
     unsafe fn children_exits(self, node: &WideNode, ray: &NodeRay, limit: f32, dist: &mut [f32; WIDTH]) -> u32;
-
-    /// The reference of the lowest child in `mask` (not empty), a mask that [`NodeKernel::children`]
-    /// or [`NodeKernel::children_exits`] returned: by default read at the slot the mask's lowest
-    /// bit names.
-    ///
-    /// # Safety
-    /// As [`NodeKernel::children`].
-    #[inline(always)]
-    unsafe fn lowest_child(self, node: &WideNode, mask: u32) -> u32 {
-        node.children[mask.trailing_zeros() as usize % WIDTH]
-    }
 }
 
 /// Four lanes at a time through glam (SSE2 on x86-64, NEON on aarch64, scalar elsewhere).
@@ -257,20 +246,6 @@ mod x86 {
                 let (enter, exit) = slabs_fused(node, ray, &self.0, limit);
                 _mm256_storeu_ps(dist.as_mut_ptr(), exit);
                 _mm256_cmp_ps_mask::<_CMP_LE_OQ>(enter, exit) as u32
-            }
-        }
-
-        #[inline(always)]
-        unsafe fn lowest_child(self, node: &WideNode, mask: u32) -> u32 {
-            // SAFETY: AVX-512 F and VL are guaranteed by the caller; the references are 32 bytes
-            // at the start of a line of the node (aligned to 64).
-            unsafe {
-                // Compressed out of a vector by the mask still in its mask register, rather than
-                // read at the slot its lowest bit names: the walk's chain from one node's test to
-                // the next node's address skips the mask's move to a general register and a load.
-                let refs = _mm256_load_si256(node.children.as_ptr() as *const __m256i);
-                let lowest = _mm256_maskz_compress_epi32(mask as __mmask8, refs);
-                _mm_cvtsi128_si32(_mm256_castsi256_si128(lowest)) as u32
             }
         }
     }

@@ -253,13 +253,11 @@ pub unsafe fn closest<K: NodeKernel, C: Counters, L: Leaves<C>>(
                 // SAFETY: the caller's guarantee.
                 let mut mask = unsafe { kernel.children(node, ray, limit, &mut dist) };
                 if mask != 0 {
-                    let entered = mask;
                     let first = take_lowest(&mut mask);
                     if mask == 0 {
                         // A lone child is not asked for: it is read next.
-                        // SAFETY: the caller's guarantee; `entered` is the kernel's mask.
-                        let reference = unsafe { kernel.lowest_child(node, entered) };
-                        current = Entry { reference, count: node.counts[first] as u32, t: dist[first] };
+                        current =
+                            Entry { reference: node.children[first], count: node.counts[first] as u32, t: dist[first] };
                         continue;
                     }
                     let a = asked_entry(nodes, node, first, &dist, leaves);
@@ -402,15 +400,10 @@ pub unsafe fn any<K: NodeKernel, C: Counters, L: Leaves<C>>(
                     // The farthest child first (the likeliest to hold an occluder: see the
                     // module documentation), the others pushed as they come; each asked for as
                     // it is met (see `prefetch_children_of`), unless it is the only one.
-                    let entered = mask;
                     let mut farthest = take_lowest(&mut mask);
-                    if mask == 0 {
-                        // SAFETY: the caller's guarantee; `entered` is the kernel's mask.
-                        let reference = unsafe { kernel.lowest_child(node, entered) };
-                        current = Entry { reference, count: node.counts[farthest] as u32, t: 0.0 };
-                        continue;
+                    if mask != 0 {
+                        prefetch_child(nodes, node.children[farthest], |first| leaves.prefetch(first));
                     }
-                    prefetch_child(nodes, node.children[farthest], |first| leaves.prefetch(first));
                     while mask != 0 {
                         let i = take_lowest(&mut mask);
                         prefetch_child(nodes, node.children[i], |first| leaves.prefetch(first));
