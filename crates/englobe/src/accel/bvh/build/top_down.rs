@@ -291,11 +291,7 @@ fn build_sequential<S: Splitter>(
 /// of [`crate::accel::bvh::stats`]; see [`super::BinnedSah::block`] for tests of several primitives). A node
 /// without area (all its primitives on one point or segment) gains nothing by a split.
 pub fn split_beats_leaf(weighted: f32, area: f32, n: usize) -> bool {
-    static COST: std::sync::OnceLock<f32> = std::sync::OnceLock::new();
-    let traversal = *COST.get_or_init(|| {
-        std::env::var("ENGLOBE_SAH_TRAVERSAL").ok().and_then(|v| v.parse().ok()).unwrap_or(SAH_TRAVERSAL_COST)
-    });
-    area > 0.0 && traversal + SAH_INTERSECTION_COST * weighted / area < SAH_INTERSECTION_COST * n as f32
+    area > 0.0 && SAH_TRAVERSAL_COST + SAH_INTERSECTION_COST * weighted / area < SAH_INTERSECTION_COST * n as f32
 }
 
 /// Reorders `refs` so that those for which `left` holds come first; returns how many they are.
