@@ -20,7 +20,7 @@ use glam::{BVec4A, IVec4, Vec3A, Vec4};
 use super::parallel;
 use super::top_down::{self, PIECE, PIECES_MIN, PrimRef, Splitter, partition, partition_large, split_beats_leaf};
 use crate::Aabb;
-use crate::accel::bvh::{BuildTree, Bvh};
+use crate::accel::bvh::{BuildTree, Bvh, SAH_TRAVERSAL_COST};
 
 /// Most bins per axis.
 pub const MAX_BINS: usize = 32;
@@ -32,7 +32,7 @@ const MAX_BLOCK: usize = 64;
 pub const DEFAULT_MAX_LEAF: usize = 8;
 
 /// The binned SAH builder. `BinnedSah::default()` uses 32 bins and leaves of at most 8 primitives.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BinnedSah {
     /// Most bins per axis, 2 to [`MAX_BINS`] (values outside are clamped); a node over `n`
     /// primitives uses at most `4 + n / 20` of them. More bins find better planes at the same
@@ -57,11 +57,24 @@ pub struct BinnedSah {
     /// query tests first) and the count splits of coincident centroids see. The bounds and the
     /// bins of large ranges are computed in pieces either way: their results are the same.
     pub parallel_partition: bool,
+    /// The SAH cost of a split's node, `C_t`, relative to one exact test
+    /// ([`crate::accel::bvh::SAH_TRAVERSAL_COST`] by default, the cost the trees' SAH is measured
+    /// with). Higher, the tree stops splitting sooner, into fewer nodes and larger leaves: what
+    /// [`crate::TriangleBvh`] builds, whose walk waits on each node test in turn while the
+    /// blocks of one leaf are tested side by side.
+    pub traversal_cost: f32,
 }
 
 impl Default for BinnedSah {
     fn default() -> Self {
-        BinnedSah { bins: MAX_BINS, max_leaf: DEFAULT_MAX_LEAF, small_leaf: 0, block: 1, parallel_partition: false }
+        BinnedSah {
+            bins: MAX_BINS,
+            max_leaf: DEFAULT_MAX_LEAF,
+            small_leaf: 0,
+            block: 1,
+            parallel_partition: false,
+            traversal_cost: SAH_TRAVERSAL_COST,
+        }
     }
 }
 
@@ -362,7 +375,7 @@ impl Splitter for BinnedSah {
         let shift = self.block.clamp(1, MAX_BLOCK).next_power_of_two().trailing_zeros();
         let (weighted, axis, plane) = best_plane(scratch, k, scale.map(|s| s > 0.0), shift)?;
         let tests = refs.len().div_ceil(1 << shift);
-        if !must_split && !split_beats_leaf(weighted, bounds.surface_area(), tests) {
+        if !must_split && !split_beats_leaf(weighted, bounds.surface_area(), tests, self.traversal_cost) {
             return None;
         }
         let plane = plane as f32;
@@ -413,7 +426,7 @@ mod tests {
         let q = validate_bvh(&BinnedSah::default().build(&boxes), &boxes).unwrap();
         assert_eq!((q.leaves, q.max_leaf), (1, 8));
         // More than a leaf may hold: split anyway, into leaves no larger than allowed.
-        let builder = BinnedSah { bins: 8, max_leaf: 3, small_leaf: 0, block: 1, parallel_partition: false };
+        let builder = BinnedSah { bins: 8, max_leaf: 3, ..BinnedSah::default() };
         let q = validate_bvh(&builder.build(&boxes), &boxes).unwrap();
         assert!(q.max_leaf <= 3 && q.leaves >= 3, "{q:?}");
     }
@@ -455,11 +468,7 @@ mod tests {
     fn bins_out_of_range_are_clamped() {
         let boxes: Vec<Aabb> = (0..100).map(|i| cube(Vec3::new(i as f32, 0.0, 0.0), 0.4)).collect();
         for bins in [0, 1, 2, 1000] {
-            validate_bvh(
-                &BinnedSah { bins, max_leaf: 4, small_leaf: 0, block: 1, parallel_partition: false }.build(&boxes),
-                &boxes,
-            )
-            .unwrap();
+            validate_bvh(&BinnedSah { bins, max_leaf: 4, ..BinnedSah::default() }.build(&boxes), &boxes).unwrap();
         }
         assert_eq!(bin_of(f32::NAN, 0.0, 1.0, 8), 0);
         assert_eq!(bin_of(f32::INFINITY, 0.0, 1.0, 8), 7);
@@ -569,7 +578,7 @@ mod tests {
         // Identical boxes: leaves of 8, split by count: 30 = 7 + 8 + 7 + 8.
         let bvh = BinnedSah::default().build(&boxes);
         assert_eq!(bvh.leaf_sizes(), [0, 0, 0, 0, 0, 0, 2, 2, 0]);
-        let one = BinnedSah { bins: 8, max_leaf: 30, small_leaf: 0, block: 1, parallel_partition: false }.build(&boxes);
+        let one = BinnedSah { bins: 8, max_leaf: 30, ..BinnedSah::default() }.build(&boxes);
         assert_eq!(one.leaf_sizes(), [0, 0, 0, 0, 0, 0, 0, 0, 1]);
     }
 }

@@ -17,7 +17,7 @@ use std::cmp::Ordering;
 use super::binned_sah::DEFAULT_MAX_LEAF;
 use super::top_down::{self, PrimRef, Splitter, split_beats_leaf};
 use crate::Aabb;
-use crate::accel::bvh::{BuildTree, Bvh};
+use crate::accel::bvh::{BuildTree, Bvh, SAH_TRAVERSAL_COST};
 
 /// The full-sweep SAH builder. `SweepSah::default()` makes leaves of at most 8 primitives, like
 /// [`super::BinnedSah::default()`], so that their trees compare.
@@ -96,7 +96,7 @@ impl Splitter for SweepSah {
             }
         }
         let (weighted, axis, mid) = best?;
-        if !must_split && !split_beats_leaf(weighted, bounds.surface_area(), n) {
+        if !must_split && !split_beats_leaf(weighted, bounds.surface_area(), n, SAH_TRAVERSAL_COST) {
             return None;
         }
         if sorted != Some(axis) {
