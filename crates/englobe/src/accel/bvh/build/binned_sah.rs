@@ -459,6 +459,18 @@ mod tests {
     }
 
     #[test]
+    fn a_dearer_node_keeps_a_leaf_that_the_default_cost_splits() {
+        // The eight cubes above, one test per primitive: a split costs C_t + 57.6 / 8.8 = C_t + 6.55
+        // against a leaf's 8, so it is taken at the default 0.5 and refused at 1.5.
+        let boxes: Vec<Aabb> = (0..8).map(|i| cube(Vec3::new(i as f32 * 0.1, 0.0, 0.0), 0.5)).collect();
+        let cheap = validate_bvh(&BinnedSah::default().build(&boxes), &boxes).unwrap();
+        assert_eq!((cheap.leaves, cheap.max_leaf), (2, 4));
+        let dear = BinnedSah { traversal_cost: 1.5, ..BinnedSah::default() };
+        let q = validate_bvh(&dear.build(&boxes), &boxes).unwrap();
+        assert_eq!((q.leaves, q.max_leaf), (1, 8));
+    }
+
+    #[test]
     fn coincident_centroids_are_split_by_count() {
         let boxes: Vec<Aabb> = (1..=1000).map(|i| cube(Vec3::ONE, i as f32)).collect();
         let q = validate_bvh(&BinnedSah::default().build(&boxes), &boxes).unwrap();
