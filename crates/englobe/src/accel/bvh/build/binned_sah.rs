@@ -442,12 +442,16 @@ mod tests {
         }
     }
 
+    /// Eight unit cubes a tenth apart along x (box area 8.8; each half's 7.2).
+    fn eight_cubes() -> Vec<Aabb> {
+        (0..8).map(|i| cube(Vec3::new(i as f32 * 0.1, 0.0, 0.0), 0.5)).collect()
+    }
+
     #[test]
     fn blocks_keep_a_leaf_that_single_tests_would_split() {
-        // Eight unit cubes a tenth apart along x (box area 8.8; each half's 7.2). One test per
-        // primitive: a split costs 0.5 + (7.2 * 4 + 7.2 * 4) / 8.8 = 7.05, under a leaf's 8. In
-        // blocks of four: 0.5 + (7.2 + 7.2) / 8.8 = 2.14, over a leaf's two blocks.
-        let boxes: Vec<Aabb> = (0..8).map(|i| cube(Vec3::new(i as f32 * 0.1, 0.0, 0.0), 0.5)).collect();
+        // One test per primitive: a split costs 0.5 + (7.2 * 4 + 7.2 * 4) / 8.8 = 7.05, under a
+        // leaf's 8. In blocks of four: 0.5 + (7.2 + 7.2) / 8.8 = 2.14, over a leaf's two blocks.
+        let boxes = eight_cubes();
         let one = validate_bvh(&BinnedSah::default().build(&boxes), &boxes).unwrap();
         assert_eq!((one.leaves, one.max_leaf), (2, 4));
         let blocks = BinnedSah { block: 4, ..BinnedSah::default() };
@@ -460,14 +464,15 @@ mod tests {
 
     #[test]
     fn a_dearer_node_keeps_a_leaf_that_the_default_cost_splits() {
-        // The eight cubes above, one test per primitive: a split costs C_t + 57.6 / 8.8 = C_t + 6.55
-        // against a leaf's 8, so it is taken at the default 0.5 and refused at 1.5.
-        let boxes: Vec<Aabb> = (0..8).map(|i| cube(Vec3::new(i as f32 * 0.1, 0.0, 0.0), 0.5)).collect();
-        let cheap = validate_bvh(&BinnedSah::default().build(&boxes), &boxes).unwrap();
-        assert_eq!((cheap.leaves, cheap.max_leaf), (2, 4));
-        let dear = BinnedSah { traversal_cost: 1.5, ..BinnedSah::default() };
-        let q = validate_bvh(&dear.build(&boxes), &boxes).unwrap();
-        assert_eq!((q.leaves, q.max_leaf), (1, 8));
+        // One test per primitive: a split costs C_t + 57.6 / 8.8 = C_t + 6.55 against a leaf's 8,
+        // so it is taken at the default 0.5 and refused at 1.5.
+        let boxes = eight_cubes();
+        let leaves = |c_t: f32| {
+            let q = validate_bvh(&BinnedSah { traversal_cost: c_t, ..BinnedSah::default() }.build(&boxes), &boxes);
+            q.map(|q| (q.leaves, q.max_leaf)).unwrap()
+        };
+        assert_eq!(leaves(0.5), (2, 4));
+        assert_eq!(leaves(1.5), (1, 8));
     }
 
     #[test]
