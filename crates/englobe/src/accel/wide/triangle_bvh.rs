@@ -32,9 +32,10 @@ pub const DEFAULT_PRESPLIT_PERCENT: u32 = 40;
 /// trees' ([`crate::accel::bvh::SAH_TRAVERSAL_COST`]). A single ray's walk waits on each node
 /// test before it can read the next node, while the blocks of one leaf are tested side by side;
 /// so the tree stops splitting sooner, into larger leaves (on the Sponza atrium 23 % fewer wide
-/// nodes, 3 % fewer visited per random ray and a quarter more triangles tested): single rays ran
-/// level to 8 % faster on the ogre and inside the Sponza, level on the bunny (within 1.2 %), and
-/// packets level (`docs/performance.md`, "Since then: a node priced at one block test").
+/// nodes, 3-4 % fewer visited per random ray and a fifth to a quarter more triangles tested):
+/// single rays ran level to 8 % faster on the ogre and inside the Sponza, level on the bunny
+/// (within 1.2 %), and packets level (`docs/performance.md`, "Since then: a node priced at one
+/// block test").
 pub const TRAVERSAL_COST: f32 = 1.0;
 
 /// How a [`TriangleBvh`] is built.

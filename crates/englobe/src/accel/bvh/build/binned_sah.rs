@@ -10,10 +10,11 @@
 //! planes between slabs are scored with the SAH from the slabs' boxes and counts, swept once from
 //! each side. The best plane of the three axes is taken if it costs less than a leaf (or if the
 //! node holds more than [`BinnedSah::max_leaf`] primitives, which it must then split). Costs use
-//! [`crate::accel::bvh::SAH_INTERSECTION_COST`] and, by default, [`crate::accel::bvh::SAH_TRAVERSAL_COST`],
-//! the constants [`crate::accel::bvh::Bvh::sah_cost`] measures with (a build may price its nodes
-//! otherwise: [`BinnedSah::traversal_cost`]): a split costs
-//! `C_t + C_i * (A_left * N_left + A_right * N_right) / A_node`, a leaf `C_i * N`. When the centroids coincide, no plane separates them and the shared top-down driver
+//! [`crate::accel::bvh::SAH_INTERSECTION_COST`] and, by default,
+//! [`crate::accel::bvh::SAH_TRAVERSAL_COST`], the constants [`crate::accel::bvh::Bvh::sah_cost`]
+//! measures with (a build may price its nodes otherwise: [`BinnedSah::traversal_cost`]): a split
+//! costs `C_t + C_i * (A_left * N_left + A_right * N_right) / A_node`, a leaf `C_i * N`. When the
+//! centroids coincide, no plane separates them and the shared top-down driver
 //! ([`super::top_down`]) splits by count. Large subtrees are built in parallel.
 
 use glam::{BVec4A, IVec4, Vec3A, Vec4};

@@ -288,10 +288,10 @@ fn build_sequential<S: Splitter>(
 /// Whether splitting a node of surface area `area` over `n` primitives beats making it a leaf,
 /// when the children's boxes' areas times their counts add up to `weighted`: a split costs
 /// `C_t + C_i * weighted / area`, a leaf `C_i * n`, `n` being the leaf's exact tests, `C_t` being
-/// `traversal` (usually [`crate::accel::bvh::SAH_TRAVERSAL_COST`]; see [`super::BinnedSah::traversal_cost`]) and
-/// `C_i` [`SAH_INTERSECTION_COST`] (see [`super::BinnedSah::block`] for tests of several
-/// primitives). A node without area (all its primitives on one point or segment) gains nothing by
-/// a split.
+/// `traversal` (usually [`crate::accel::bvh::SAH_TRAVERSAL_COST`]; see
+/// [`super::BinnedSah::traversal_cost`]) and `C_i` [`SAH_INTERSECTION_COST`] (see
+/// [`super::BinnedSah::block`] for tests of several primitives). A node without area (all its
+/// primitives on one point or segment) gains nothing by a split.
 pub fn split_beats_leaf(weighted: f32, area: f32, n: usize, traversal: f32) -> bool {
     area > 0.0 && traversal + SAH_INTERSECTION_COST * weighted / area < SAH_INTERSECTION_COST * n as f32
 }
