@@ -33,7 +33,7 @@ pub const ROWS: usize = 6;
 /// One node: eight children's boxes (row `2 * axis` the lower planes, `2 * axis + 1` the upper
 /// planes, column = child slot) and references.
 #[derive(Clone, Copy, Debug, PartialEq)]
-#[repr(C, align(256))]
+#[repr(C, align(64))]
 pub struct WideNode {
     /// The children's planes, one row of eight per plane (see [`ROWS`]).
     pub bounds: [[f32; WIDTH]; ROWS],
