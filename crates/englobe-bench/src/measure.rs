@@ -1,7 +1,6 @@
-//! Timing: a query set traced by each library on a pool of `n` threads, the rays split into chunks
-//! that the threads take in turn; the libraries' runs taken in turn, each timed run after an
-//! untimed one of its own, `reps` timed runs per library, and their median. Results are written
-//! into buffers allocated once, outside the timed runs.
+//! Timing: a query set traced by one library on a pool of `n` threads, the rays split into chunks
+//! that the threads take in turn; one untimed warm-up run, then `reps` timed runs, and their
+//! median. Results are written into buffers allocated once, outside the timed runs.
 
 use std::time::Instant;
 
@@ -92,33 +91,26 @@ pub fn median(values: &[f64]) -> f64 {
     if v.len() % 2 == 1 { v[mid] } else { 0.5 * (v[mid - 1] + v[mid]) }
 }
 
-/// `reps` timed runs of each library over `rays` on `pool`, interleaved: each round times one run
-/// of every library, in the order given on even rounds and the reverse on odd ones, each timed
-/// run right after an untimed one of its own library, so that it starts with its own structure in
-/// the caches rather than the one timed before it. A shared machine's load drifts over a run; timed one after another, each library would meet
-/// another part of that drift, and their ratios would carry it. Interleaved, every library meets
-/// all of it, and the medians compare. `answers[i]` gets library `i`'s answers of its last run.
-pub fn time_queries(
+/// Warm-up then `reps` timed runs of `query` over `rays` on `pool`; the answers of the last run
+/// are left in `answers`.
+pub fn time_query(
     pool: &rayon::ThreadPool,
-    libraries: &[&dyn Library],
+    library: &dyn Library,
     rays: &[BenchRay],
-    answers: &mut [Answers],
+    answers: &mut Answers,
     reps: usize,
-) -> Vec<Timing> {
-    assert_eq!(libraries.len(), answers.len(), "one answer buffer per library");
-    let mut timings = vec![Timing { runs: Vec::with_capacity(reps) }; libraries.len()];
+) -> Timing {
     pool.install(|| {
-        for round in 0..reps {
-            for k in 0..libraries.len() {
-                let i = if round % 2 == 0 { k } else { libraries.len() - 1 - k };
-                trace(libraries[i], rays, &mut answers[i]);
+        trace(library, rays, answers);
+        let runs = (0..reps)
+            .map(|_| {
                 let start = Instant::now();
-                trace(libraries[i], rays, &mut answers[i]);
-                timings[i].runs.push(start.elapsed().as_secs_f64());
-            }
-        }
-    });
-    timings
+                trace(library, rays, answers);
+                start.elapsed().as_secs_f64()
+            })
+            .collect();
+        Timing { runs }
+    })
 }
 
 /// What [`time_build`] measured.
@@ -192,41 +184,6 @@ where
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// A library that notes its name at each call and answers nothing.
-    struct Noting<'a> {
-        name: &'static str,
-        log: &'a std::sync::Mutex<Vec<&'static str>>,
-    }
-
-    impl Library for Noting<'_> {
-        fn structure(&self) -> String {
-            self.name.to_string()
-        }
-        fn closest_hits(&self, _: &[BenchRay], out: &mut [RayResult]) {
-            self.log.lock().unwrap().push(self.name);
-            out.fill(RayResult::MISS);
-        }
-        fn any_hits(&self, _: &[BenchRay], out: &mut [bool]) {
-            self.log.lock().unwrap().push(self.name);
-            out.fill(false);
-        }
-    }
-
-    #[test]
-    fn interleaved_libraries_take_turns_each_timed_after_a_run_of_its_own() {
-        let log = std::sync::Mutex::new(Vec::new());
-        let (a, b, c) =
-            (Noting { name: "a", log: &log }, Noting { name: "b", log: &log }, Noting { name: "c", log: &log });
-        let libraries: [&dyn Library; 3] = [&a, &b, &c];
-        // Fewer rays than a chunk: one call per run.
-        let rays = vec![BenchRay { origin: glam::Vec3::ZERO, t_min: 0.0, dir: glam::Vec3::X, t_max: 1.0 }; 10];
-        let mut answers: Vec<Answers> = (0..3).map(|_| Answers::new(Query::Any, rays.len())).collect();
-        let timings = time_queries(&thread_pool(1).unwrap(), &libraries, &rays, &mut answers, 3);
-        assert!(timings.iter().all(|t| t.runs.len() == 3));
-        let order: String = log.into_inner().unwrap().concat();
-        assert_eq!(order, "aabbccccbbaaaabbcc");
-    }
 
     #[test]
     fn resident_memory_is_read_in_bytes() {

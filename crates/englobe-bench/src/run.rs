@@ -1,8 +1,7 @@
 //! One benchmark run: every scene file is read first, so that a bad one stops the run before
 //! anything is measured; then for each scene, the ray sets are generated once, and for each
-//! thread count every library is built (timed), then every cell is traced by all the libraries in
-//! turn, round after round (timed: see [`measure::time_queries`]), and their answers are checked
-//! against brute force. A table is printed per scene and thread count; the
+//! thread count and library, the library is built (timed), every cell is traced (timed) and its
+//! answers are checked against brute force. A table is printed per scene and thread count; the
 //! CSV is rewritten (atomically) after every measurement, so that a crash or an interrupt keeps
 //! everything measured until then; its path is printed last.
 
@@ -92,21 +91,14 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<ExitCode> {
             let pool = measure::thread_pool(threads)?;
             let settings = BuildSettings { threads, englobe, embree_robust: args.embree_robust };
             let first = all.len();
-            // Every library built first, then each cell traced by all of them in turn (see
-            // `measure::time_queries`).
-            let mut built = Vec::with_capacity(libraries.len());
             for &kind in &libraries {
                 progress(format!("{}: {kind} on {threads} thread(s): building", scene.name));
                 let build_reps = args.build_reps.unwrap_or(args.reps);
                 let (library, build) =
                     measure::time_build(&pool, build_reps, || build_library(kind, &scene, &settings))?;
-                built.push((kind, library, build));
-            }
-            let each: Vec<&dyn Library> = built.iter().map(|(_, library, _)| library.as_ref()).collect();
-            for &cell in &cells {
-                progress(format!("{}: {} on {threads} thread(s), every library in turn", scene.name, cell.name()));
-                let measured = measure_cell(&pool, &each, &scene, &sets, cell, &references, args);
-                for ((kind, _, build), (m, mismatches)) in built.iter().zip(measured) {
+                for &cell in &cells {
+                    progress(format!("{}: {kind} on {threads} thread(s): {}", scene.name, cell.name()));
+                    let (m, mismatches) = measure_cell(&pool, library.as_ref(), &scene, &sets, cell, &references, args);
                     if mismatches.checked > 0 && !mismatches.acceptable(args.tolerance) {
                         failures.push(format!(
                             "{}: {kind} on {threads} thread(s), {}: {} of {} rays disagree with brute force \
@@ -120,17 +112,15 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<ExitCode> {
                         ));
                     }
                     all.push(Measurement {
-                        library: *kind,
+                        library: kind,
                         threads,
                         build_ms: build.ms,
                         build_resident_bytes: build.resident_bytes,
                         ..m
                     });
+                    results::fill_ratios(&mut all);
+                    results::write_atomically(&args.csv, &results::to_csv(&all))?;
                 }
-                // Library by library, as the tables list them.
-                all[first..].sort_by_key(|m| libraries.iter().position(|&k| k == m.library));
-                results::fill_ratios(&mut all);
-                results::write_atomically(&args.csv, &results::to_csv(&all))?;
             }
             results::fill_ratios(&mut all);
             print!("{}", report::table(&all[first..], &cells));
@@ -195,50 +185,43 @@ fn references(
     Ok(out)
 }
 
-/// Times one cell, every library in turn ([`measure::time_queries`]), and checks each one's
-/// answers (a measurement's library, threads and build time are the caller's to fill in).
+/// Times one cell and checks its answers (the measurement's library, threads and build time are
+/// the caller's to fill in).
 fn measure_cell(
     pool: &rayon::ThreadPool,
-    libraries: &[&dyn Library],
+    library: &dyn Library,
     scene: &BenchScene,
     sets: &RaySets,
     cell: Cell,
     references: &BTreeMap<RaySetKind, Reference>,
     args: &BenchArgs,
-) -> Vec<(Measurement, Mismatches)> {
+) -> (Measurement, Mismatches) {
     let rays = sets.get(cell.rays);
-    let mut answers: Vec<Answers> = libraries.iter().map(|_| Answers::new(cell.query, rays.len())).collect();
-    let timings = measure::time_queries(pool, libraries, rays, &mut answers, args.reps);
-    libraries
-        .iter()
-        .zip(timings)
-        .zip(&answers)
-        .map(|((library, timing), answers)| {
-            let mismatches = references.get(&cell.rays).map(|r| match answers {
-                Answers::Closest(out) => agreement::check_closest(r, out),
-                Answers::Any(out) => agreement::check_any(r, out),
-            });
-            let mismatches = mismatches.unwrap_or_default();
-            let m = Measurement {
-                scene: scene.name.clone(),
-                triangles: scene.triangle_count(),
-                library: LibraryKind::Englobe,
-                structure: library.structure(),
-                rays: cell.rays,
-                query: cell.query,
-                threads: 1,
-                ray_count: rays.len(),
-                reps: args.reps,
-                seconds: timing.median(),
-                build_ms: 0.0,
-                build_resident_bytes: None,
-                checked: mismatches.checked,
-                mismatches: mismatches.total(),
-                ratio_to_embree: None,
-                ratio_to_obvhs: None,
-                seed: args.seed,
-            };
-            (m, mismatches)
-        })
-        .collect()
+    let mut answers = Answers::new(cell.query, rays.len());
+    let timing = measure::time_query(pool, library, rays, &mut answers, args.reps);
+    let mismatches = references.get(&cell.rays).map(|r| match &answers {
+        Answers::Closest(out) => agreement::check_closest(r, out),
+        Answers::Any(out) => agreement::check_any(r, out),
+    });
+    let mismatches = mismatches.unwrap_or_default();
+    let m = Measurement {
+        scene: scene.name.clone(),
+        triangles: scene.triangle_count(),
+        library: LibraryKind::Englobe,
+        structure: library.structure(),
+        rays: cell.rays,
+        query: cell.query,
+        threads: 1,
+        ray_count: rays.len(),
+        reps: args.reps,
+        seconds: timing.median(),
+        build_ms: 0.0,
+        build_resident_bytes: None,
+        checked: mismatches.checked,
+        mismatches: mismatches.total(),
+        ratio_to_embree: None,
+        ratio_to_obvhs: None,
+        seed: args.seed,
+    };
+    (m, mismatches)
 }
