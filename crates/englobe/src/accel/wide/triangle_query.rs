@@ -75,17 +75,14 @@ impl<C: Counters, F: HitFilter<Hit>> RayQuery for Any<'_, C, F> {
 }
 
 /// An any-hit walk of the whole tree with `kernel`, compiled into the query that makes it.
-///
-/// It keeps the ray, not the node test's form of it ([`NodeRay`]): each walk makes that as a
-/// local of its own. The walk is handed by reference to the cold function that makes it again
-/// ([`triangle_leaves::any_hit_with`]), so whatever it holds lives in memory; a `NodeRay` held here
-/// was stored to the frame at every query, and read back from there after every leaf.
 struct TreeWalk<'a, K, C> {
     kernel: K,
     isa: Isa,
     nodes: &'a [WideNode],
     depth: u32,
-    ray: &'a Ray,
+    ray: NodeRay,
+    /// Where a box may begin and still be entered by an any-hit walk.
+    limit: f32,
     counters: &'a mut C,
 }
 
@@ -96,24 +93,30 @@ impl<'a, K: NodeKernel, C: Counters> TreeWalk<'a, K, C> {
     /// As [`NodeKernel::children`]: the walks run compiled with the kernel's target features, on
     /// a processor that has them.
     #[inline(always)]
-    unsafe fn new(kernel: K, bvh: &'a TriangleBvh, ray: &'a Ray, counters: &'a mut C) -> Self {
-        TreeWalk { kernel, isa: bvh.isa(), nodes: bvh.nodes(), depth: bvh.depth(), ray, counters }
+    unsafe fn new(kernel: K, bvh: &'a TriangleBvh, ray: &Ray, counters: &'a mut C) -> Self {
+        TreeWalk {
+            kernel,
+            isa: bvh.isa(),
+            nodes: bvh.nodes(),
+            depth: bvh.depth(),
+            ray: NodeRay::new(ray),
+            limit: reach(ray.t_max),
+            counters,
+        }
     }
 }
 
 impl<F: HitFilter<Hit>, K: NodeKernel, C: Counters> AnyWalk<F> for TreeWalk<'_, K, C> {
     #[inline(always)]
     fn walk(&mut self, leaves: &mut TriangleLeaves<'_, F>) -> bool {
-        let (ray, limit) = (NodeRay::new(self.ray), reach(self.ray.t_max));
         // SAFETY: `TreeWalk::new`'s guarantee; the tree's interior references index its nodes,
         // as the builders make them.
-        unsafe { traverse::any(self.kernel, self.nodes, self.depth, 0, &ray, limit, leaves, self.counters) }
+        unsafe { traverse::any(self.kernel, self.nodes, self.depth, 0, &self.ray, self.limit, leaves, self.counters) }
     }
 
     #[inline(always)]
     fn walk_again(&mut self, leaves: &mut TriangleLeaves<'_, F>) -> bool {
-        let (ray, limit) = (NodeRay::new(self.ray), reach(self.ray.t_max));
-        dispatch::any(self.isa, self.nodes, self.depth, 0, &ray, limit, leaves, self.counters)
+        dispatch::any(self.isa, self.nodes, self.depth, 0, &self.ray, self.limit, leaves, self.counters)
     }
 }
 
