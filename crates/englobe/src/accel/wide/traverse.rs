@@ -10,11 +10,9 @@
 //! camera predict well (selecting there too cost primary rays 2-4 %, see `docs/performance.md`).
 //!
 //! Occlusion queries stop at the first occluder and do not sort: they enter the *farthest* child
-//! hit first and leave the others in one stack entry, their node's, with the mask of their slots
-//! (one entry per node rather than one per child: most occlusion rays stop at their first leaf
-//! and never come back for them). A ray's far boxes are where the surfaces that close a scene lie
-//! (walls, floors, the far side of a mesh), which nearly every ray that is occluded at all meets;
-//! its near boxes hold the small geometry around its origin, which it mostly passes by.
+//! hit first and push the others as they come. A ray's far boxes are where the surfaces that close
+//! a scene lie (walls, floors, the far side of a mesh), which nearly every ray that is occluded at
+//! all meets; its near boxes hold the small geometry around its origin, which it mostly passes by.
 //! Measured against nearest first (the example `triangle_bvh_stats`, and the renderer's `--stats`),
 //! it visits 28 % fewer nodes on random rays in the Sponza, 16 % fewer on its shadow rays, and
 //! never more on the other meshes and scenes (see `docs/performance.md`). The binary traversal
@@ -48,8 +46,7 @@ pub const INLINE_DEPTH: usize = 32;
 const INLINE_ENTRIES: usize = (WIDTH - 1) * INLINE_DEPTH + 1;
 
 /// A pending child: its reference, its leaf item count, and the distance at which the ray enters
-/// its box. On the stack of an occlusion walk ([`any`]), a node with children still to enter: the
-/// node's reference, and in `count` the mask of those children's slots (`t` unused).
+/// its box.
 #[derive(Clone, Copy, Debug)]
 pub struct Entry {
     reference: u32,
@@ -400,27 +397,27 @@ pub unsafe fn any<K: NodeKernel, C: Counters, L: Leaves<C>>(
                 // SAFETY: the caller's guarantee. (`dist`: where the ray leaves each child.)
                 let mut mask = unsafe { kernel.children_exits(node, ray, limit, &mut dist) };
                 if mask != 0 {
-                    let first = take_lowest(&mut mask);
-                    if mask == 0 {
-                        // A lone child is not asked for: it is read next.
-                        current = Entry { reference: node.children[first], count: node.counts[first] as u32, t: 0.0 };
-                        continue;
-                    }
                     // The farthest child first (the likeliest to hold an occluder: see the
-                    // module documentation); the others stay in one entry, this node's with the
-                    // mask of its children still to enter (see `Entry`), each asked for now (see
-                    // `prefetch_children_of`).
-                    let entered = mask | 1 << first;
-                    let mut farthest = first;
-                    prefetch_child(nodes, node.children[first], |first| leaves.prefetch(first));
+                    // module documentation), the others pushed as they come; each asked for as
+                    // it is met (see `prefetch_children_of`), unless it is the only one.
+                    let mut farthest = take_lowest(&mut mask);
+                    if mask != 0 {
+                        prefetch_child(nodes, node.children[farthest], |first| leaves.prefetch(first));
+                    }
                     while mask != 0 {
                         let i = take_lowest(&mut mask);
                         prefetch_child(nodes, node.children[i], |first| leaves.prefetch(first));
                         // Selected, not branched on: which child reaches farther is a coin toss.
-                        farthest = std::hint::select_unpredictable(dist[i] > dist[farthest], i, farthest);
+                        let further = dist[i] > dist[farthest];
+                        let push = std::hint::select_unpredictable(further, farthest, i);
+                        farthest = std::hint::select_unpredictable(further, i, farthest);
+                        stack[len].write(Entry {
+                            reference: node.children[push],
+                            count: node.counts[push] as u32,
+                            t: 0.0,
+                        });
+                        len += 1;
                     }
-                    stack[len].write(Entry { reference: current.reference, count: entered & !(1 << farthest), t: 0.0 });
-                    len += 1;
                     current = Entry { reference: node.children[farthest], count: node.counts[farthest] as u32, t: 0.0 };
                     continue;
                 }
@@ -428,20 +425,9 @@ pub unsafe fn any<K: NodeKernel, C: Counters, L: Leaves<C>>(
             if len == 0 {
                 break 'walk false;
             }
-            // The next child of the node on top, the highest slot first (the order in which the
-            // children were once pushed one by one); the node leaves the stack with its last.
+            len -= 1;
             // SAFETY: entries below `len` were written.
-            let top = unsafe { stack[len - 1].assume_init_mut() };
-            let slot = (u32::BITS - 1 - top.count.leading_zeros()) as usize;
-            top.count &= !(1 << slot);
-            let parent = top.reference as usize;
-            if top.count == 0 {
-                len -= 1;
-            }
-            debug_assert!(parent < nodes.len() && slot < WIDTH);
-            // SAFETY: the entry's node was visited, so its reference indexes `nodes`.
-            let node = unsafe { nodes.get_unchecked(parent) };
-            current = Entry { reference: node.children[slot], count: node.counts[slot] as u32, t: 0.0 };
+            current = unsafe { stack[len].assume_init() };
         }
     };
     give_back(deep);
