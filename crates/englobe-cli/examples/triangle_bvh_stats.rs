@@ -10,7 +10,8 @@
 //!     ../shared/scenes/meshes/sponza-dabrovic/sponza.obj
 //! ```
 //!
-//! `--presplit PERCENT` first builds with that pre-split budget instead of the library's default.
+//! `--presplit PERCENT` first builds with that pre-split budget instead of the library's default;
+//! `--spatial LEVELS` (after it, if both) with spatial splits in that many top levels instead.
 //! The SAH cost is given in the units of Embree's own report, to set beside it (see
 //! `docs/performance.md`).
 
@@ -30,6 +31,11 @@ fn main() -> anyhow::Result<()> {
     if args.first().is_some_and(|a| a == "--presplit") {
         let percent = args.get(1).context("--presplit needs a percentage")?;
         options.presplit_percent = percent.parse().with_context(|| format!("--presplit {percent}"))?;
+        args.drain(..2);
+    }
+    if args.first().is_some_and(|a| a == "--spatial") {
+        let levels = args.get(1).context("--spatial needs a number of levels")?;
+        options.spatial_levels = levels.parse().with_context(|| format!("--spatial {levels}"))?;
         args.drain(..2);
     }
     for path in args {

@@ -35,7 +35,11 @@ fn brute(tris: &[[Vec3; 3]], ray: &Ray) -> (Option<Hit>, bool) {
 /// Checks `bvh` in every available instruction set against brute force on every ray; returns the
 /// number of rays that hit.
 fn check(tris: &[[Vec3; 3]], rays: &[Ray]) -> Result<usize, String> {
-    let mut bvh = TriangleBvh::from_triangles(tris);
+    check_built(TriangleBvh::from_triangles(tris), tris, rays)
+}
+
+/// [`check`] on a structure built over `tris` some other way.
+fn check_built(mut bvh: TriangleBvh, tris: &[[Vec3; 3]], rays: &[Ray]) -> Result<usize, String> {
     let expected: Vec<(Option<Hit>, bool)> = rays.iter().map(|r| brute(tris, r)).collect();
     for isa in Isa::available() {
         bvh.set_isa(isa).map_err(|e| e.to_string())?;
@@ -384,6 +388,53 @@ fn cut_triangles_are_found_once_and_exactly() {
         let expected: Vec<u32> =
             (0..tris.len() as u32).filter(|&i| triangle_overlaps_box(tris[i as usize], &query)).collect();
         assert_eq!(bvh.triangles_in_box(&query), expected);
+        let mut listed = Vec::new();
+        bvh.for_each_triangle_in_box(&query, |t| listed.push(t));
+        listed.sort_unstable();
+        assert_eq!(listed, expected, "a triangle listed twice or missed");
+    }
+}
+
+/// Spatial splits (an option of the build): struts among small triangles are cut where the top
+/// levels' splits are, every piece's box holds its part of the strut, and every query stays brute
+/// force's, each triangle found once.
+#[test]
+fn spatial_splits_are_found_once_and_exactly() {
+    use englobe::Aabb;
+    use englobe::accel::Validate;
+    use englobe::accel::wide::TriangleBvhOptions;
+    use englobe::shapes::triangle_overlaps_box;
+
+    let mut rng = seeded(43);
+    let mut tris: Vec<[Vec3; 3]> = (0..2000)
+        .map(|_| {
+            let c = in_cube(&mut rng) * 4.0;
+            [c, c + in_cube(&mut rng) * 0.05, c + in_cube(&mut rng) * 0.05]
+        })
+        .collect();
+    for _ in 0..30 {
+        let (a, b) = (in_cube(&mut rng) * 4.0, in_cube(&mut rng) * 4.0);
+        tris.push([a, b, b + in_cube(&mut rng) * 0.1]);
+    }
+    let options = TriangleBvhOptions { spatial_levels: 6, ..Default::default() };
+    let bvh = TriangleBvh::build_with(tris.len(), |i| tris[i as usize], options);
+    let boxes: Vec<Aabb> = tris.iter().map(|t| Aabb::from_points(*t)).collect();
+    let stats = bvh.validate(&boxes, None).expect("a valid structure");
+    assert!(stats.prim_refs > tris.len() + 10, "{} references: nothing was cut", stats.prim_refs);
+    assert!(stats.prim_refs <= tris.len() * 3 / 2, "{} references: over the budget", stats.prim_refs);
+
+    let bounds = boxes.iter().fold(Aabb::EMPTY, |b, t| b.union(t));
+    let mut rays: Vec<Ray> = (0..400).map(|_| ray_into_box(&mut rng, &bounds)).collect();
+    rays.extend(rays_into_struts(&mut rng, &tris[2000..], &bounds));
+    let built = TriangleBvh::build_with(tris.len(), |i| tris[i as usize], options);
+    let hits = check_built(built, &tris, &rays).expect("agreement with brute force");
+    assert!(hits > 300, "{hits} hits");
+
+    for _ in 0..50 {
+        let (a, b) = (in_box(&mut rng, &bounds), in_box(&mut rng, &bounds));
+        let query = Aabb::new(a.min(b), a.max(b));
+        let expected: Vec<u32> =
+            (0..tris.len() as u32).filter(|&i| triangle_overlaps_box(tris[i as usize], &query)).collect();
         let mut listed = Vec::new();
         bvh.for_each_triangle_in_box(&query, |t| listed.push(t));
         listed.sort_unstable();

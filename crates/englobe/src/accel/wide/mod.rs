@@ -30,7 +30,8 @@
 //!   [`TriangleBvh`], with `triangle_leaves` (inside the crate): a ray's leaf tests;
 //!   [`triangle_packet`]: its packet queries and batches, with `triangle_packet_leaves` (inside
 //!   the crate): a packet's leaf tests, and [`ray_packet`], the rays and hits of a packet as rows
-//!   that programs fill and read; [`presplit`]: the large triangles cut before its build.
+//!   that programs fill and read; [`presplit`]: the large triangles cut before its build, or,
+//!   by choice, [`spatial`]: those cut by spatial splits in its top levels.
 //! * [`point_query`]: the closest point of the triangles to a point; [`box_query`]: the
 //!   triangles overlapping a box.
 //! * [`refit`]: the boxes recomputed after the triangles moved, and the SAH cost that says when
@@ -61,6 +62,7 @@ pub mod point_query;
 pub mod presplit;
 pub mod ray_packet;
 pub mod refit;
+pub mod spatial;
 pub mod traverse;
 pub mod triangle_bvh;
 mod triangle_leaves;

@@ -1,0 +1,504 @@
+//! Spatial splits in the top levels of the tree, decided before the build: where a large
+//! triangle straddles a good split plane, it is cut there, and the build sees its pieces.
+//!
+//! A BVH bounds whole primitives, so a node split by its primitives' centroids gets two children
+//! that overlap wherever a large triangle straddles the plane; a ray through the overlap visits
+//! both. Stich, Friedrich and Dietrich (2009), "Spatial Splits in Bounding Volume Hierarchies",
+//! let each split choose between the usual object split and a spatial split, which cuts the
+//! references straddling its plane in two, by the surface area heuristic (SAH), and then puts a
+//! cut reference back whole on one side where that costs less ("reference unsplitting"). The
+//! pre-split ([`super::presplit`]) cuts triangles by how much their boxes waste, wherever they lie;
+//! spatial splits cut them where the tree's splits are, and only where the SAH gains from it.
+//!
+//! The wide build is the binned SAH build, unchanged: this module runs the SBVH's choice over the
+//! top [`TriangleBvhOptions::spatial_levels`] binary levels of a tree of its own (binned object
+//! and spatial splits, Stich et al.'s sections 3 and 4) and hands the build the references it
+//! ends with, each a box around its part of a triangle. Below those levels, or in a subtree with
+//! no triangle left that may be cut, nothing more is cut and the subtree's references are handed
+//! over as they are. A triangle may be cut if its box wastes at least [`MIN_CUT_SHARE`] of the
+//! scene box's area; the others go whole to the side of their centroid, as in an object split.
+//! The cuts add at most [`MAX_EXTRA`] times as many references as there are triangles, that
+//! budget shared down the tree.
+//!
+//! A cut reference's box is the bounds of the triangle clipped to its side of the plane (in
+//! `f64`, rounded outward: [`crate::shapes::clip::clip_triangle`]), so a fragment's box always
+//! holds its part of the triangle, and the queries stay exact as they do with the pre-split (each
+//! leaf tests the whole triangle). Binning, which only chooses the plane, cuts the reference's
+//! box at the bins' planes, as Embree's fast spatial split builder does, rather than the triangle:
+//! on the Sponza the same tree within a few references, in a fraction of the time.
+//!
+//! Off by default: on the Sponza it takes the wide nodes visited per random ray from 6.9 to 5.5
+//! (closest hit) and from 3.9 to 2.8 (any hit), 15-25 % faster rays, but its own passes cost about
+//! as much as the rest of the build (see `docs/performance.md`, "Since then: spatial splits in the
+//! top levels"), and the bunny and the ogre gain nothing from it.
+//!
+//! [`TriangleBvhOptions::spatial_levels`]: super::triangle_bvh::TriangleBvhOptions::spatial_levels
+
+use glam::{Vec3, Vec3A};
+
+use super::presplit::{Fragments, TriangleBox};
+use crate::Aabb;
+use crate::accel::MAX_PRIMITIVES;
+use crate::accel::bvh::build::parallel;
+use crate::accel::bvh::build::top_down::PrimRef;
+use crate::shapes::clip::clip_triangle;
+
+/// Bins per axis, for object splits and for spatial splits.
+const BINS: usize = 32;
+
+/// The least area a triangle's box must waste, as a share of the scene box's surface area, for
+/// the triangle to be cut (a box wasting 1/100 000 of the scene's area; the pre-split's floor,
+/// 1/2048, left most of the Sponza's useful cuts out: 1.2 % more references instead of 9 %, 6.2
+/// wide nodes per random closest-hit ray instead of 5.4).
+pub const MIN_CUT_SHARE: f32 = 1e-5;
+
+/// Nodes with fewer references are not split further here (the build splits them).
+const MIN_REFS: usize = 32;
+
+/// Nodes with at least this many references bin in pieces, in parallel.
+const PARALLEL_REFS: usize = 1 << 14;
+
+/// A spatial split is looked for only where the best object split's children overlap by at least
+/// this share of the scene box's area (Stich et al.'s `alpha`, section 4.3): elsewhere cutting
+/// cannot gain much.
+const MIN_OVERLAP_SHARE: f32 = 1e-4;
+
+/// Most references the cuts may add, as a share of the triangles: a bound on memory whatever the
+/// scene (the SAH alone would stop far below it on real scenes), shared out down the tree in
+/// proportion to the references on each side, as Embree's spatial split builder shares its own.
+pub const MAX_EXTRA: f64 = 0.5;
+
+/// A reference: a box around a triangle or a part of one, its triangle (the caller's index), and
+/// in its spare lane 1 if the triangle is large enough to be cut, 0 if not.
+type Frag = PrimRef;
+
+fn frag(bounds: &Aabb, owner: u32, large: bool) -> Frag {
+    PrimRef::with_spare(bounds, owner, if large { 1.0 } else { 0.0 })
+}
+
+fn is_large(f: &Frag) -> bool {
+    f.spare() > 0.0
+}
+
+/// A box as two vectors, for the passes over references.
+#[derive(Clone, Copy, Debug)]
+struct Bounds {
+    lo: Vec3A,
+    hi: Vec3A,
+}
+
+impl Bounds {
+    const EMPTY: Bounds = Bounds { lo: Vec3A::INFINITY, hi: Vec3A::NEG_INFINITY };
+
+    #[inline]
+    fn add(&mut self, lo: Vec3A, hi: Vec3A) {
+        self.lo = self.lo.min(lo);
+        self.hi = self.hi.max(hi);
+    }
+
+    #[inline]
+    fn union(self, o: Bounds) -> Bounds {
+        Bounds { lo: self.lo.min(o.lo), hi: self.hi.max(o.hi) }
+    }
+
+    fn aabb(&self) -> Aabb {
+        Aabb::new(self.lo.into(), self.hi.into())
+    }
+
+    fn area(&self) -> f32 {
+        self.aabb().surface_area()
+    }
+}
+
+/// Cuts the large ones among triangles `triangle(i)`, `i` in `0..count` (each described by
+/// `describe(i)`, its box finite and not empty), with spatial splits in the top `levels` levels;
+/// `None` when no triangle is cut (the build then takes the triangles' own boxes). The fragments
+/// come out in the same order whatever the threads.
+pub fn spatial_cuts(
+    count: usize,
+    describe: impl Fn(usize) -> TriangleBox + Sync,
+    triangle: impl Fn(u32) -> [Vec3; 3] + Sync,
+    levels: u32,
+) -> Option<Fragments> {
+    if levels == 0 || count < MIN_REFS {
+        return None;
+    }
+    let scene = parallel::map_chunks(&(0..count).collect::<Vec<_>>(), 1 << 14, |c| {
+        c.iter().fold(Aabb::EMPTY, |s, &i| s.union(&describe(i).bounds))
+    })
+    .into_iter()
+    .fold(Aabb::EMPTY, |s, b| s.union(&b));
+    if !scene.is_finite() {
+        return None;
+    }
+    let floor = scene.surface_area() * MIN_CUT_SHARE;
+    let refs = parallel::collect_indexed(count, 1 << 14, |i| {
+        let t = describe(i);
+        frag(&t.bounds, i as u32, t.waste >= floor)
+    });
+    if !refs.iter().any(is_large) {
+        return None;
+    }
+    let splitter = Splits { triangle: &triangle, min_overlap: scene.surface_area() * MIN_OVERLAP_SHARE, levels };
+    // References stay within what a build may hold (its bins count them in `i32` lanes), and
+    // within a budget of extra ones however many the SAH would like.
+    let budget = ((count as f64 * MAX_EXTRA) as usize).min(MAX_PRIMITIVES.saturating_sub(count));
+    let out = splitter.node(refs, budget, 0);
+    if out.len() == count {
+        return None;
+    }
+    Some(Fragments {
+        boxes: out.iter().map(PrimRef::bounds).collect(),
+        owner: out.iter().map(PrimRef::index).collect(),
+    })
+}
+
+struct Splits<'a, T> {
+    triangle: &'a T,
+    min_overlap: f32,
+    levels: u32,
+}
+
+/// What one pass over a node's references gathers, per axis and bin: for object splits, the
+/// references whose centroid falls in the bin and their boxes; for spatial splits, the parts of
+/// references in the bin, how many references start in it and how many end in it.
+#[derive(Clone)]
+struct Bins {
+    object: [[Bounds; BINS]; 3],
+    counts: [[u32; BINS]; 3],
+    spatial: [[Bounds; BINS]; 3],
+    enter: [[u32; BINS]; 3],
+    exit: [[u32; BINS]; 3],
+}
+
+impl Bins {
+    fn new() -> Self {
+        Bins {
+            object: [[Bounds::EMPTY; BINS]; 3],
+            counts: [[0; BINS]; 3],
+            spatial: [[Bounds::EMPTY; BINS]; 3],
+            enter: [[0; BINS]; 3],
+            exit: [[0; BINS]; 3],
+        }
+    }
+
+    fn merge(mut self, other: &Bins) -> Self {
+        for a in 0..3 {
+            for k in 0..BINS {
+                self.object[a][k] = self.object[a][k].union(other.object[a][k]);
+                self.counts[a][k] += other.counts[a][k];
+                self.spatial[a][k] = self.spatial[a][k].union(other.spatial[a][k]);
+                self.enter[a][k] += other.enter[a][k];
+                self.exit[a][k] += other.exit[a][k];
+            }
+        }
+        self
+    }
+}
+
+/// A node's grid of bins: `origin + k * width` starts bin `k` on each axis.
+#[derive(Clone, Copy)]
+struct Grid {
+    origin: Vec3A,
+    width: Vec3A,
+    /// Bins per unit of length (zero on a flat axis).
+    scale: Vec3A,
+}
+
+impl Grid {
+    fn over(b: &Bounds) -> Self {
+        let width = (b.hi - b.lo) / BINS as f32;
+        let scale = Vec3A::select(width.cmpgt(Vec3A::ZERO), width.recip(), Vec3A::ZERO);
+        Grid { origin: b.lo, width, scale }
+    }
+
+    /// The bins of `p` on the three axes (anything below the grid, and NaN, in bin 0).
+    #[inline]
+    fn bins(&self, p: Vec3A) -> [usize; 3] {
+        let k = ((p - self.origin) * self.scale).max(Vec3A::ZERO).min(Vec3A::splat((BINS - 1) as f32));
+        [k.x as usize, k.y as usize, k.z as usize]
+    }
+
+    #[inline]
+    fn bin(&self, axis: usize, x: f32) -> usize {
+        let k = (x - self.origin[axis]) * self.scale[axis];
+        if k >= 0.0 { (k as usize).min(BINS - 1) } else { 0 }
+    }
+
+    #[inline]
+    fn plane(&self, axis: usize, k: usize) -> f32 {
+        self.origin[axis] + k as f32 * self.width[axis]
+    }
+}
+
+/// The best split found on one axis: its SAH cost (areas times references), the bin it starts the
+/// right side at, and the two sides' boxes.
+#[derive(Clone, Copy)]
+struct Best {
+    cost: f32,
+    axis: usize,
+    bin: usize,
+    left: Bounds,
+    right: Bounds,
+}
+
+/// The best split of a sweep over bins (their boxes, and the references counted on the left and on
+/// the right of a plane after them or before them), with at most `max_refs` references on both
+/// sides together.
+fn sweep(
+    axis: usize,
+    boxes: &[Bounds; BINS],
+    left_counts: &[u32; BINS],
+    right_counts: &[u32; BINS],
+    max_refs: usize,
+    best: &mut Option<Best>,
+) {
+    let mut right = [(Bounds::EMPTY, 0u32); BINS];
+    let mut acc = (Bounds::EMPTY, 0);
+    for k in (1..BINS).rev() {
+        acc = (acc.0.union(boxes[k]), acc.1 + right_counts[k]);
+        right[k] = acc;
+    }
+    let mut left = (Bounds::EMPTY, 0);
+    for k in 1..BINS {
+        left = (left.0.union(boxes[k - 1]), left.1 + left_counts[k - 1]);
+        let (rb, rn) = right[k];
+        if left.1 == 0 || rn == 0 || (left.1 + rn) as usize > max_refs {
+            continue;
+        }
+        let cost = left.0.area() * left.1 as f32 + rb.area() * rn as f32;
+        if best.is_none_or(|b| cost < b.cost) {
+            *best = Some(Best { cost, axis, bin: k, left: left.0, right: rb });
+        }
+    }
+}
+
+impl<T: Fn(u32) -> [Vec3; 3] + Sync> Splits<'_, T> {
+    /// The references of the subtree over `refs`, at depth `depth`, cut where its splits say,
+    /// adding at most `budget` references.
+    fn node(&self, refs: Vec<Frag>, budget: usize, depth: u32) -> Vec<Frag> {
+        if depth >= self.levels || refs.len() < MIN_REFS || !refs.iter().any(is_large) {
+            return refs;
+        }
+        let n = refs.len();
+        let Some((left, right)) = self.split(refs.as_slice(), budget) else {
+            return refs;
+        };
+        drop(refs);
+        // What is left of the budget, shared in proportion to each side's references.
+        let rest = budget.saturating_sub(left.len() + right.len() - n);
+        let to_left = (rest as f64 * left.len() as f64 / (left.len() + right.len()) as f64) as usize;
+        let (mut l, r) = if left.len().min(right.len()) >= PARALLEL_REFS / 4 {
+            parallel::join(|| self.node(left, to_left, depth + 1), || self.node(right, rest - to_left, depth + 1))
+        } else {
+            (self.node(left, to_left, depth + 1), self.node(right, rest - to_left, depth + 1))
+        };
+        l.extend(r);
+        l
+    }
+
+    /// The node's two sides, by the best object or spatial split, or `None` if it has none.
+    fn split(&self, refs: &[Frag], budget: usize) -> Option<(Vec<Frag>, Vec<Frag>)> {
+        let (mut bounds, mut centroids) = (Bounds::EMPTY, Bounds::EMPTY);
+        for r in refs {
+            bounds.add(r.min(), r.max());
+            let c = r.centroid();
+            centroids.add(c, c);
+        }
+        let (cgrid, sgrid) = (Grid::over(&centroids), Grid::over(&bounds));
+        let bins = if refs.len() >= PARALLEL_REFS {
+            let parts = parallel::map_chunks(refs, PARALLEL_REFS / 2, |c| bin(c, &cgrid, &sgrid));
+            parts.iter().skip(1).fold(parts[0].clone(), |a, b| a.merge(b))
+        } else {
+            bin(refs, &cgrid, &sgrid)
+        };
+        let mut object = None;
+        for axis in (0..3).filter(|&a| centroids.hi[a] > centroids.lo[a]) {
+            sweep(axis, &bins.object[axis], &bins.counts[axis], &bins.counts[axis], usize::MAX, &mut object);
+        }
+        let overlap = object.map_or(f32::INFINITY, |b| b.left.aabb().intersection(&b.right.aabb()).surface_area());
+        let mut spatial = None;
+        if overlap >= self.min_overlap {
+            for axis in (0..3).filter(|&a| bounds.hi[a] > bounds.lo[a]) {
+                let max = refs.len() + budget;
+                sweep(axis, &bins.spatial[axis], &bins.enter[axis], &bins.exit[axis], max, &mut spatial);
+            }
+        }
+        match (object, spatial) {
+            (o, Some(s)) if o.is_none_or(|o| s.cost < o.cost) => {
+                Some(self.cut(refs, s.axis, sgrid.plane(s.axis, s.bin)))
+            }
+            (Some(o), _) => {
+                let (l, r): (Vec<Frag>, Vec<Frag>) =
+                    refs.iter().partition(|f| cgrid.bin(o.axis, f.centroid_on(o.axis)) < o.bin);
+                (!l.is_empty() && !r.is_empty()).then_some((l, r))
+            }
+            (None, _) => None,
+        }
+    }
+
+    /// The two sides of a spatial split at `plane` on `axis`: the references on one side go there,
+    /// a large triangle's reference across the plane is cut in two, or goes whole to the side
+    /// where that costs less (Stich et al.'s unsplitting), any other across it goes by its
+    /// centroid, as binned.
+    fn cut(&self, refs: &[Frag], axis: usize, plane: f32) -> (Vec<Frag>, Vec<Frag>) {
+        let (mut l, mut r, mut across) = (Vec::new(), Vec::new(), Vec::new());
+        let (mut lb, mut rb) = (Aabb::EMPTY, Aabb::EMPTY);
+        for f in refs {
+            let large = is_large(f);
+            let (lo, hi) = (f.min()[axis], f.max()[axis]);
+            let to_left = if large && lo < plane && hi > plane {
+                across.push(*f);
+                continue;
+            } else if large {
+                hi <= plane
+            } else {
+                f.centroid_on(axis) < plane
+            };
+            if to_left {
+                lb = lb.union(&f.bounds());
+                l.push(*f);
+            } else {
+                rb = rb.union(&f.bounds());
+                r.push(*f);
+            }
+        }
+        for f in across {
+            let whole = f.bounds();
+            let v = (self.triangle)(f.index());
+            let (mut below, mut above) = (whole, whole);
+            below.max[axis] = plane;
+            above.min[axis] = plane;
+            let (cl, cr) = (clip_triangle(v, &below), clip_triangle(v, &above));
+            let (nl, nr) = (l.len() as f32, r.len() as f32);
+            let area = |b: Aabb| b.surface_area();
+            let both = area(lb.union(&cl)) * (nl + 1.0) + area(rb.union(&cr)) * (nr + 1.0);
+            let left = area(lb.union(&whole)) * (nl + 1.0) + area(rb) * nr;
+            let right = area(lb) * nl + area(rb.union(&whole)) * (nr + 1.0);
+            if cl.is_empty() || (right <= both && right <= left) {
+                rb = rb.union(&whole);
+                r.push(f);
+            } else if cr.is_empty() || left <= both {
+                lb = lb.union(&whole);
+                l.push(f);
+            } else {
+                lb = lb.union(&cl);
+                rb = rb.union(&cr);
+                l.push(frag(&cl, f.index(), true));
+                r.push(frag(&cr, f.index(), true));
+            }
+        }
+        (l, r)
+    }
+}
+
+/// One pass over `refs`: object bins by centroid on `cgrid`; spatial bins on `sgrid`, a large
+/// triangle's reference in every bin its box crosses (its box cut to each bin's slab: only to
+/// choose a plane by; the cut itself clips the triangle), any other reference, which is never cut,
+/// whole in its centroid's bin.
+fn bin(refs: &[Frag], cgrid: &Grid, sgrid: &Grid) -> Bins {
+    let mut bins = Bins::new();
+    for r in refs {
+        let (lo, hi, c) = (r.min(), r.max(), r.centroid());
+        let cb = cgrid.bins(c);
+        let (first, last) = if is_large(r) { (sgrid.bins(lo), sgrid.bins(hi)) } else { (sgrid.bins(c), sgrid.bins(c)) };
+        for axis in 0..3 {
+            bins.object[axis][cb[axis]].add(lo, hi);
+            bins.counts[axis][cb[axis]] += 1;
+            let (a, b) = (first[axis], last[axis]);
+            bins.enter[axis][a] += 1;
+            bins.exit[axis][b] += 1;
+            if a == b {
+                bins.spatial[axis][a].add(lo, hi);
+                continue;
+            }
+            for k in a..=b {
+                let (mut plo, mut phi) = (lo, hi);
+                if k != a {
+                    plo[axis] = sgrid.plane(axis, k);
+                }
+                if k != b {
+                    phi[axis] = sgrid.plane(axis, k + 1);
+                }
+                bins.spatial[axis][k].add(plo, phi);
+            }
+        }
+    }
+    bins
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A grid of small flat triangles in the unit square's plane (z = 0) scaled to `side`, and the
+    /// triangles' descriptions.
+    fn grid(n: usize, size: f32) -> Vec<[Vec3; 3]> {
+        (0..n * n)
+            .map(|k| {
+                let o = Vec3::new((k % n) as f32, (k / n) as f32, 0.0);
+                [o, o + Vec3::new(size, 0.0, 0.0), o + Vec3::new(0.0, size, 0.0)]
+            })
+            .collect()
+    }
+
+    fn cuts(tris: &[[Vec3; 3]], levels: u32) -> Option<Fragments> {
+        spatial_cuts(tris.len(), |i| TriangleBox::of(&tris[i]), |i| tris[i as usize], levels)
+    }
+
+    #[test]
+    fn a_long_triangle_is_cut_and_its_pieces_cover_it() {
+        let mut tris = grid(40, 0.5);
+        // Corner to corner over the grid, a little above it.
+        let long = [Vec3::new(0.0, 0.0, 1.0), Vec3::new(40.0, 40.0, 1.0), Vec3::new(40.0, 39.0, 2.0)];
+        tris.push(long);
+        let f = cuts(&tris, 6).expect("the long triangle cut");
+        let last = (tris.len() - 1) as u32;
+        let pieces: Vec<Aabb> = f.owner.iter().zip(&f.boxes).filter(|(o, _)| **o == last).map(|(_, b)| *b).collect();
+        assert!(pieces.len() >= 4, "{} pieces", pieces.len());
+        let own = Aabb::from_points(long);
+        assert!(pieces.iter().all(|p| own.contains_box(p)));
+        let area: f32 = pieces.iter().map(Aabb::surface_area).sum();
+        assert!(area < 0.5 * own.surface_area(), "{area}");
+        // Points sampled on the triangle, edges included, lie in some piece.
+        for k in 0..300 {
+            let (a, b) = ((k % 20) as f32 / 19.0, (k / 20) as f32 / 14.0);
+            let (a, b) = if a + b > 1.0 { (1.0 - a, 1.0 - b) } else { (a, b) };
+            let p = long[0] + (long[1] - long[0]) * a + (long[2] - long[0]) * b;
+            assert!(pieces.iter().any(|q| q.contains_point(p)), "{p} in no piece");
+        }
+        // Every other triangle is there once, whole.
+        for i in 0..last {
+            let mine: Vec<&Aabb> = f.owner.iter().zip(&f.boxes).filter(|(o, _)| **o == i).map(|(_, b)| b).collect();
+            assert_eq!(mine.len(), 1, "triangle {i}");
+            assert_eq!(*mine[0], Aabb::from_points(tris[i as usize]), "triangle {i}");
+        }
+        // The same fragments in the same order, again.
+        assert_eq!(cuts(&tris, 6), Some(f));
+    }
+
+    #[test]
+    fn nothing_is_cut_without_levels_or_large_triangles() {
+        // Tiny triangles: none wastes 1/100 000 of the scene's area.
+        let tris = grid(100, 0.1);
+        assert_eq!(cuts(&tris, 6), None);
+        let mut tris = grid(40, 0.5);
+        tris.push([Vec3::ZERO, Vec3::new(40.0, 40.0, 1.0), Vec3::new(40.0, 39.0, 2.0)]);
+        assert_eq!(cuts(&tris, 0), None);
+    }
+
+    #[test]
+    fn the_cuts_stay_within_their_budget() {
+        // Long triangles fanned across the whole scene: every split would cut them all, and the
+        // budget (80 references for these 160 triangles) runs out after the first.
+        let mut tris = grid(10, 0.5);
+        for k in 0..60 {
+            let y = k as f32 * 0.15;
+            tris.push([Vec3::new(0.0, y, 0.5), Vec3::new(10.0, 10.0 - y, 0.5), Vec3::new(10.0, 10.0 - y, 0.7)]);
+        }
+        let f = cuts(&tris, 12).expect("cuts");
+        let limit = tris.len() + (tris.len() as f64 * MAX_EXTRA) as usize;
+        assert!(f.boxes.len() <= limit, "{} fragments for {} triangles", f.boxes.len(), tris.len());
+        assert!(f.boxes.len() > tris.len());
+    }
+}
