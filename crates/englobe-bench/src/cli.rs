@@ -48,8 +48,9 @@ pub struct BenchArgs {
     /// englobe's structure (default: the best this build of englobe has).
     #[arg(long, value_parser = EnglobeStructure::parse, value_name = "NAME")]
     pub englobe_accel: Option<EnglobeStructure>,
-    /// Pre-split budget of englobe's triangle BVH, in percent more references than triangles
-    /// (default: the library's, `TriangleBvhOptions::default()`; 0 cuts no triangle).
+    /// Pre-split budget of englobe's triangle BVH, in percent more references than triangles,
+    /// with no spatial splits (default: the library's cuts, `TriangleBvhOptions::default()`:
+    /// spatial splits on a scene of large triangles, else the pre-split; 0 cuts no triangle).
     #[arg(long, value_name = "PERCENT")]
     pub englobe_presplit: Option<u32>,
     /// Cells to measure, comma-separated, or `all` (default: primary-closest, random-closest,

@@ -370,7 +370,7 @@ fn cut_triangles_are_found_once_and_exactly() {
     let whole = TriangleBvh::build_with(
         tris.len(),
         |i| tris[i as usize],
-        TriangleBvhOptions { presplit_percent: 0, ..Default::default() },
+        TriangleBvhOptions { presplit_percent: 0, spatial_levels: 0, ..Default::default() },
     );
     assert_eq!(whole.stats().prim_refs, tris.len());
 
@@ -412,11 +412,12 @@ fn spatial_splits_are_found_once_and_exactly() {
             [c, c + in_cube(&mut rng) * 0.05, c + in_cube(&mut rng) * 0.05]
         })
         .collect();
-    for _ in 0..30 {
+    for _ in 0..100 {
         let (a, b) = (in_cube(&mut rng) * 4.0, in_cube(&mut rng) * 4.0);
         tris.push([a, b, b + in_cube(&mut rng) * 0.1]);
     }
-    let options = TriangleBvhOptions { spatial_levels: 6, ..Default::default() };
+    // No pre-split: every cut is the spatial splits'.
+    let options = TriangleBvhOptions { spatial_levels: 6, presplit_percent: 0, ..Default::default() };
     let bvh = TriangleBvh::build_with(tris.len(), |i| tris[i as usize], options);
     let boxes: Vec<Aabb> = tris.iter().map(|t| Aabb::from_points(*t)).collect();
     let stats = bvh.validate(&boxes, None).expect("a valid structure");

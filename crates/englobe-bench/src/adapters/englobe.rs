@@ -36,7 +36,8 @@ pub enum EnglobeStructure {
     Triangles {
         /// The instruction set, if not the processor's best.
         isa: Option<Isa>,
-        /// [`TriangleBvhOptions::presplit_percent`], if not the library's default.
+        /// [`TriangleBvhOptions::presplit_percent`], if not the library's default: the pre-split
+        /// with that budget, and no spatial splits.
         presplit_percent: Option<u32>,
     },
 }
@@ -129,9 +130,10 @@ impl EnglobeLibrary {
             }
             EnglobeStructure::Triangles { isa, presplit_percent } => {
                 let defaults = TriangleBvhOptions::default();
-                let options = TriangleBvhOptions {
-                    presplit_percent: presplit_percent.unwrap_or(defaults.presplit_percent),
-                    ..defaults
+                // A budget given is the pre-split's alone, with no spatial splits.
+                let options = match presplit_percent {
+                    Some(percent) => TriangleBvhOptions { presplit_percent: percent, spatial_levels: 0, ..defaults },
+                    None => defaults,
                 };
                 let mesh = &scene.mesh;
                 let mut bvh = TriangleBvh::build_with(mesh.len(), |i| mesh.triangle(i).vertices, options);
@@ -275,7 +277,7 @@ mod tests {
         };
         let triangles = scene.mesh.len();
         // The atrium's walls and floors are long triangles whose boxes waste area: the default
-        // budget cuts some of them, a budget of 0 none.
+        // build cuts some of them (by spatial splits), a pre-split budget of 0 none.
         let (default_refs, default_label) = references(None);
         let (uncut, uncut_label) = references(Some(0));
         assert!(default_refs > triangles, "{default_refs} references for {triangles} triangles");

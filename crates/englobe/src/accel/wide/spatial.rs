@@ -27,19 +27,20 @@
 //! box at the bins' planes, as Embree's fast spatial split builder does, rather than the triangle:
 //! on the Sponza the same tree within a few references, in a fraction of the time.
 //!
-//! Off by default: on the Sponza it takes the wide nodes visited per random ray from 6.9 to 5.5
-//! (closest hit) and from 3.9 to 2.8 (any hit), 15-25 % faster rays, but its own passes cost about
-//! as much as the rest of the build (see `docs/performance.md`, "Since then: spatial splits in the
-//! top levels"), and the bunny and the ogre gain nothing from it.
+//! Only on a scene with large triangles ([`MIN_LARGE_WASTE`]): on the Sponza it takes the wide
+//! nodes visited per random ray from 6.9 to 5.5 (closest hit) and from 3.9 to 2.8 (any hit)
+//! against the pre-split, 11-23 % faster rays, for a build a third longer (see
+//! `docs/performance.md`, "Since then: spatial splits in the top levels"); the bunny and the ogre
+//! would gain nothing from it, and do not run it.
 //!
 //! [`TriangleBvhOptions::spatial_levels`]: super::triangle_bvh::TriangleBvhOptions::spatial_levels
 
 use glam::{Vec3, Vec3A};
 
-use super::presplit::{Fragments, TriangleBox};
+use super::presplit::{Fragments, MIN_WASTE_SHARE, TriangleBox};
 use crate::Aabb;
 use crate::accel::MAX_PRIMITIVES;
-use crate::accel::bvh::build::parallel;
+use crate::accel::bvh::build::parallel::{self, collect_indexed};
 use crate::accel::bvh::build::top_down::PrimRef;
 use crate::shapes::clip::clip_triangle;
 
@@ -51,6 +52,16 @@ const BINS: usize = 32;
 /// 1/2048, left most of the Sponza's useful cuts out: 1.2 % more references instead of 9 %, 6.2
 /// wide nodes per random closest-hit ray instead of 5.4).
 pub const MIN_CUT_SHARE: f32 = 1e-5;
+
+/// Spatial splits are tried only on a scene whose large triangles (those whose box wastes at least
+/// [`MIN_WASTE_SHARE`] of the scene box's area, the pre-split's floor) waste together at least
+/// this many times the scene box's area. The Sponza's 1 677 large triangles waste 8.5 times it;
+/// the bunny has none, the ogre 20 wasting 0.012 times it, and no tiling of an even mesh has
+/// any: there the spatial splits would cost the build a third more and gain nothing.
+pub const MIN_LARGE_WASTE: f32 = 1.0;
+
+/// Triangles per task in the passes over all of them.
+const CHUNK: usize = 1 << 14;
 
 /// Nodes with fewer references are not split further here (the build splits them).
 const MIN_REFS: usize = 32;
@@ -112,8 +123,9 @@ impl Bounds {
 
 /// Cuts the large ones among triangles `triangle(i)`, `i` in `0..count` (each described by
 /// `describe(i)`, its box finite and not empty), with spatial splits in the top `levels` levels;
-/// `None` when no triangle is cut (the build then takes the triangles' own boxes). The fragments
-/// come out in the same order whatever the threads.
+/// `None` when no triangle is cut (the build then takes the triangles' own boxes), and without
+/// trying when the scene's triangles are even (see [`MIN_LARGE_WASTE`]). The fragments come out
+/// in the same order whatever the threads.
 pub fn spatial_cuts(
     count: usize,
     describe: impl Fn(usize) -> TriangleBox + Sync,
@@ -123,22 +135,30 @@ pub fn spatial_cuts(
     if levels == 0 || count < MIN_REFS {
         return None;
     }
-    let scene = parallel::map_chunks(&(0..count).collect::<Vec<_>>(), 1 << 14, |c| {
-        c.iter().fold(Aabb::EMPTY, |s, &i| s.union(&describe(i).bounds))
-    })
-    .into_iter()
-    .fold(Aabb::EMPTY, |s, b| s.union(&b));
+    // The passes over every triangle go in fixed chunks, in parallel: the sums come out the same
+    // whatever the threads.
+    let chunks = count.div_ceil(CHUNK);
+    let chunk = |c: usize| c * CHUNK..((c + 1) * CHUNK).min(count);
+    let scene = collect_indexed(chunks, 1, |c| chunk(c).fold(Aabb::EMPTY, |s, i| s.union(&describe(i).bounds)))
+        .into_iter()
+        .fold(Aabb::EMPTY, |s, b| s.union(&b));
     if !scene.is_finite() {
         return None;
     }
+    let large = scene.surface_area() * MIN_WASTE_SHARE;
+    let waste: f64 = collect_indexed(chunks, 1, |c| {
+        chunk(c).map(|i| describe(i).waste).filter(|&w| w >= large).map(f64::from).sum::<f64>()
+    })
+    .into_iter()
+    .sum();
+    if !(waste >= (MIN_LARGE_WASTE * scene.surface_area()) as f64) {
+        return None;
+    }
     let floor = scene.surface_area() * MIN_CUT_SHARE;
-    let refs = parallel::collect_indexed(count, 1 << 14, |i| {
+    let refs = collect_indexed(count, CHUNK, |i| {
         let t = describe(i);
         frag(&t.bounds, i as u32, t.waste >= floor)
     });
-    if !refs.iter().any(is_large) {
-        return None;
-    }
     let splitter = Splits { triangle: &triangle, min_overlap: scene.surface_area() * MIN_OVERLAP_SHARE, levels };
     // References stay within what a build may hold (its bins count them in `i32` lanes), and
     // within a budget of extra ones however many the SAH would like.
@@ -449,11 +469,16 @@ mod tests {
     #[test]
     fn a_long_triangle_is_cut_and_its_pieces_cover_it() {
         let mut tris = grid(40, 0.5);
-        // Corner to corner over the grid, a little above it.
+        // Corner to corner over the grid, a little above it; alone, it does not waste enough to
+        // make the spatial splits run.
         let long = [Vec3::new(0.0, 0.0, 1.0), Vec3::new(40.0, 40.0, 1.0), Vec3::new(40.0, 39.0, 2.0)];
         tris.push(long);
-        let f = cuts(&tris, 6).expect("the long triangle cut");
+        assert_eq!(cuts(&tris, 6), None);
+        // Two more make it.
         let last = (tris.len() - 1) as u32;
+        tris.push([Vec3::new(0.0, 40.0, 0.5), Vec3::new(40.0, 0.0, 0.5), Vec3::new(39.0, 0.0, 1.5)]);
+        tris.push([Vec3::new(0.0, 20.0, 1.5), Vec3::new(40.0, 21.0, 1.5), Vec3::new(40.0, 22.0, 0.5)]);
+        let f = cuts(&tris, 6).expect("the long triangles cut");
         let pieces: Vec<Aabb> = f.owner.iter().zip(&f.boxes).filter(|(o, _)| **o == last).map(|(_, b)| *b).collect();
         assert!(pieces.len() >= 4, "{} pieces", pieces.len());
         let own = Aabb::from_points(long);
@@ -467,7 +492,7 @@ mod tests {
             let p = long[0] + (long[1] - long[0]) * a + (long[2] - long[0]) * b;
             assert!(pieces.iter().any(|q| q.contains_point(p)), "{p} in no piece");
         }
-        // Every other triangle is there once, whole.
+        // Every small triangle is there once, whole.
         for i in 0..last {
             let mine: Vec<&Aabb> = f.owner.iter().zip(&f.boxes).filter(|(o, _)| **o == i).map(|(_, b)| b).collect();
             assert_eq!(mine.len(), 1, "triangle {i}");

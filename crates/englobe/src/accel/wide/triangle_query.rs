@@ -148,7 +148,8 @@ mod tests {
     fn an_any_hit_walk_that_meets_too_many_undecided_lanes_is_made_again_on_every_instruction_set() {
         for n in [3, 8, 9, 20, 41] {
             let tris = fans(n);
-            let options = TriangleBvhOptions { presplit_percent: 0, ..TriangleBvhOptions::default() };
+            let options =
+                TriangleBvhOptions { presplit_percent: 0, spatial_levels: 0, ..TriangleBvhOptions::default() };
             let mut bvh = TriangleBvh::build_with(n, |i| tris[i as usize], options);
             let ray = Ray::new(Vec3::Z, -Vec3::Z);
             for isa in Isa::available() {
