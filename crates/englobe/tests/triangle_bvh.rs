@@ -338,26 +338,16 @@ fn cut_triangles_among_left_out_ones_keep_their_indices() {
 }
 
 /// Long diagonal struts among small triangles: the build cuts the struts into pieces that lie in
-/// several leaves (see `englobe::accel::wide::presplit`). The structure stays valid, every query
+/// several leaves (see `englobe::accel::wide::presplit` and `spatial`). The structure stays valid, every query
 /// stays brute force's, and the box query still lists each triangle once.
 #[test]
 fn cut_triangles_are_found_once_and_exactly() {
     use englobe::Aabb;
     use englobe::accel::Validate;
     use englobe::accel::wide::TriangleBvhOptions;
-    use englobe::shapes::triangle_overlaps_box;
 
     let mut rng = seeded(41);
-    let mut tris: Vec<[Vec3; 3]> = (0..400)
-        .map(|_| {
-            let c = in_cube(&mut rng) * 4.0;
-            [c, c + in_cube(&mut rng) * 0.05, c + in_cube(&mut rng) * 0.05]
-        })
-        .collect();
-    for _ in 0..30 {
-        let (a, b) = (in_cube(&mut rng) * 4.0, in_cube(&mut rng) * 4.0);
-        tris.push([a, b, b + in_cube(&mut rng) * 0.1]);
-    }
+    let tris = struts_among_small_triangles(&mut rng, 400, 30);
     let bvh = TriangleBvh::from_triangles(&tris);
     let boxes: Vec<Aabb> = tris.iter().map(|t| Aabb::from_points(*t)).collect();
     let stats = bvh.validate(&boxes, None).expect("a valid structure");
@@ -382,20 +372,10 @@ fn cut_triangles_are_found_once_and_exactly() {
     let hits = check(&tris, &rays).expect("agreement with brute force");
     assert!(hits > 300, "{hits} hits");
 
-    for _ in 0..50 {
-        let (a, b) = (in_box(&mut rng, &bounds), in_box(&mut rng, &bounds));
-        let query = Aabb::new(a.min(b), a.max(b));
-        let expected: Vec<u32> =
-            (0..tris.len() as u32).filter(|&i| triangle_overlaps_box(tris[i as usize], &query)).collect();
-        assert_eq!(bvh.triangles_in_box(&query), expected);
-        let mut listed = Vec::new();
-        bvh.for_each_triangle_in_box(&query, |t| listed.push(t));
-        listed.sort_unstable();
-        assert_eq!(listed, expected, "a triangle listed twice or missed");
-    }
+    box_queries_list_each_triangle_once(&bvh, &tris, &mut rng, &bounds);
 }
 
-/// Spatial splits (an option of the build): struts among small triangles are cut where the top
+/// Spatial splits alone (no pre-split): struts among small triangles are cut where the top
 /// levels' splits are, every piece's box holds its part of the strut, and every query stays brute
 /// force's, each triangle found once.
 #[test]
@@ -403,19 +383,9 @@ fn spatial_splits_are_found_once_and_exactly() {
     use englobe::Aabb;
     use englobe::accel::Validate;
     use englobe::accel::wide::TriangleBvhOptions;
-    use englobe::shapes::triangle_overlaps_box;
 
     let mut rng = seeded(43);
-    let mut tris: Vec<[Vec3; 3]> = (0..2000)
-        .map(|_| {
-            let c = in_cube(&mut rng) * 4.0;
-            [c, c + in_cube(&mut rng) * 0.05, c + in_cube(&mut rng) * 0.05]
-        })
-        .collect();
-    for _ in 0..100 {
-        let (a, b) = (in_cube(&mut rng) * 4.0, in_cube(&mut rng) * 4.0);
-        tris.push([a, b, b + in_cube(&mut rng) * 0.1]);
-    }
+    let tris = struts_among_small_triangles(&mut rng, 2000, 100);
     // No pre-split: every cut is the spatial splits'.
     let options = TriangleBvhOptions { spatial_levels: 6, presplit_percent: 0, ..Default::default() };
     let bvh = TriangleBvh::build_with(tris.len(), |i| tris[i as usize], options);
@@ -431,11 +401,39 @@ fn spatial_splits_are_found_once_and_exactly() {
     let hits = check_built(built, &tris, &rays).expect("agreement with brute force");
     assert!(hits > 300, "{hits} hits");
 
+    box_queries_list_each_triangle_once(&bvh, &tris, &mut rng, &bounds);
+}
+
+/// `small` small triangles in a cube of side 8, then `struts` long thin ones across it.
+fn struts_among_small_triangles(rng: &mut rand_pcg::Pcg32, small: usize, struts: usize) -> Vec<[Vec3; 3]> {
+    let mut tris: Vec<[Vec3; 3]> = (0..small)
+        .map(|_| {
+            let c = in_cube(rng) * 4.0;
+            [c, c + in_cube(rng) * 0.05, c + in_cube(rng) * 0.05]
+        })
+        .collect();
+    for _ in 0..struts {
+        let (a, b) = (in_cube(rng) * 4.0, in_cube(rng) * 4.0);
+        tris.push([a, b, b + in_cube(rng) * 0.1]);
+    }
+    tris
+}
+
+/// Boxes at random in `bounds`: both box queries list exactly the triangles that overlap each,
+/// every one once, however many pieces it was cut into.
+fn box_queries_list_each_triangle_once(
+    bvh: &TriangleBvh,
+    tris: &[[Vec3; 3]],
+    rng: &mut rand_pcg::Pcg32,
+    bounds: &englobe::Aabb,
+) {
+    use englobe::shapes::triangle_overlaps_box;
     for _ in 0..50 {
-        let (a, b) = (in_box(&mut rng, &bounds), in_box(&mut rng, &bounds));
-        let query = Aabb::new(a.min(b), a.max(b));
+        let (a, b) = (in_box(rng, bounds), in_box(rng, bounds));
+        let query = englobe::Aabb::new(a.min(b), a.max(b));
         let expected: Vec<u32> =
             (0..tris.len() as u32).filter(|&i| triangle_overlaps_box(tris[i as usize], &query)).collect();
+        assert_eq!(bvh.triangles_in_box(&query), expected);
         let mut listed = Vec::new();
         bvh.for_each_triangle_in_box(&query, |t| listed.push(t));
         listed.sort_unstable();
