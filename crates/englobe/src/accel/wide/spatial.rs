@@ -56,8 +56,8 @@ pub const MIN_CUT_SHARE: f32 = 1e-5;
 /// Spatial splits are tried only on a scene whose large triangles (those whose box wastes at least
 /// [`MIN_WASTE_SHARE`] of the scene box's area, the pre-split's floor) waste together at least
 /// this many times the scene box's area. The Sponza's 1 677 large triangles waste 8.5 times it;
-/// the bunny has none, the ogre 20 wasting 0.012 times it, and no tiling of an even mesh has
-/// any: there the spatial splits would cost the build a third more and gain nothing.
+/// the bunny has none, the ogre 20 wasting 0.012 times it, and the bunny tiled into millions of
+/// triangles none: there the spatial splits cost the build about half again and gained nothing.
 pub const MIN_LARGE_WASTE: f32 = 1.0;
 
 /// Triangles per task in the passes over all of them.
@@ -76,7 +76,7 @@ const MIN_OVERLAP_SHARE: f32 = 1e-4;
 
 /// Most references the cuts may add, as a share of the triangles: a bound on memory whatever the
 /// scene (the SAH alone would stop far below it on real scenes), shared out down the tree in
-/// proportion to the references on each side, as Embree's spatial split builder shares its own.
+/// proportion to the references on each side.
 pub const MAX_EXTRA: f64 = 0.5;
 
 /// A reference: a box around a triangle or a part of one, its triangle (the caller's index), and
