@@ -182,7 +182,6 @@ struct Splits<'a, T> {
 /// What one pass over a node's references gathers, per axis and bin: for object splits, the
 /// references whose centroid falls in the bin and their boxes; for spatial splits, the parts of
 /// references in the bin, how many references start in it and how many end in it.
-#[derive(Clone)]
 struct Bins {
     object: [[Bounds; BINS]; 3],
     counts: [[u32; BINS]; 3],
@@ -328,7 +327,7 @@ impl<T: Fn(u32) -> [Vec3; 3] + Sync> Splits<'_, T> {
         let (cgrid, sgrid) = (Grid::over(&centroids), Grid::over(&bounds));
         let bins = if refs.len() >= PARALLEL_REFS {
             let parts = parallel::map_chunks(refs, PARALLEL_REFS / 2, |c| bin(c, &cgrid, &sgrid));
-            parts.iter().skip(1).fold(parts[0].clone(), |a, b| a.merge(b))
+            parts.into_iter().reduce(|a, b| a.merge(&b)).expect("at least one piece")
         } else {
             bin(refs, &cgrid, &sgrid)
         };
@@ -451,8 +450,8 @@ fn bin(refs: &[Frag], cgrid: &Grid, sgrid: &Grid) -> Bins {
 mod tests {
     use super::*;
 
-    /// A grid of small flat triangles in the unit square's plane (z = 0) scaled to `side`, and the
-    /// triangles' descriptions.
+    /// An `n` by `n` grid of flat right triangles of legs `size`, one per unit square, in the
+    /// plane z = 0.
     fn grid(n: usize, size: f32) -> Vec<[Vec3; 3]> {
         (0..n * n)
             .map(|k| {
