@@ -35,11 +35,12 @@
 //!
 //! [`TriangleBvhOptions::spatial_levels`]: super::triangle_bvh::TriangleBvhOptions::spatial_levels
 
-use glam::{Vec3, Vec3A};
+use glam::{BVec3A, Vec3, Vec3A};
 
 use super::presplit::{Fragments, MIN_WASTE_SHARE, TriangleBox};
 use crate::Aabb;
 use crate::accel::MAX_PRIMITIVES;
+use crate::accel::bvh::build::binned_sah::bin_vector;
 use crate::accel::bvh::build::parallel::{self, collect_indexed};
 use crate::accel::bvh::build::top_down::PrimRef;
 use crate::shapes::clip::clip_triangle;
@@ -101,7 +102,7 @@ struct Bounds {
 impl Bounds {
     const EMPTY: Bounds = Bounds { lo: Vec3A::INFINITY, hi: Vec3A::NEG_INFINITY };
 
-    #[inline]
+    #[inline(always)]
     fn add(&mut self, lo: Vec3A, hi: Vec3A) {
         self.lo = self.lo.min(lo);
         self.hi = self.hi.max(hi);
@@ -118,6 +119,39 @@ impl Bounds {
 
     fn area(&self) -> f32 {
         self.aabb().surface_area()
+    }
+}
+
+/// One side of a split as it is filled: its references, their bounds, the bounds of their
+/// centroids and how many may be cut, gathered as the references come, so that the side's own
+/// split starts without a pass over them.
+struct Side {
+    refs: Vec<Frag>,
+    bounds: Bounds,
+    centroids: Bounds,
+    large: usize,
+}
+
+impl Side {
+    fn with_capacity(n: usize) -> Self {
+        Side { refs: Vec::with_capacity(n), bounds: Bounds::EMPTY, centroids: Bounds::EMPTY, large: 0 }
+    }
+
+    #[inline(always)]
+    fn push(&mut self, f: Frag) {
+        self.bounds.add(f.min(), f.max());
+        let c = f.centroid();
+        self.centroids.add(c, c);
+        self.large += usize::from(is_large(&f));
+        self.refs.push(f);
+    }
+
+    fn merge(mut self, other: Side) -> Side {
+        self.refs.extend(other.refs);
+        self.bounds = self.bounds.union(other.bounds);
+        self.centroids = self.centroids.union(other.centroids);
+        self.large += other.large;
+        self
     }
 }
 
@@ -155,21 +189,28 @@ pub fn spatial_cuts(
         return None;
     }
     let floor = scene.surface_area() * MIN_CUT_SHARE;
-    let refs = collect_indexed(count, CHUNK, |i| {
-        let t = describe(i);
-        frag(&t.bounds, i as u32, t.waste >= floor)
-    });
+    let root = collect_indexed(chunks, 1, |c| {
+        let mut side = Side::with_capacity(CHUNK);
+        for i in chunk(c) {
+            let t = describe(i);
+            side.push(frag(&t.bounds, i as u32, t.waste >= floor));
+        }
+        side
+    })
+    .into_iter()
+    .reduce(Side::merge)
+    .expect("at least one chunk");
     let splitter = Splits { triangle: &triangle, min_overlap: scene.surface_area() * MIN_OVERLAP_SHARE, levels };
     // References stay within what a build may hold (its bins count them in `i32` lanes), and
     // within a budget of extra ones however many the SAH would like.
     let budget = ((count as f64 * MAX_EXTRA) as usize).min(MAX_PRIMITIVES.saturating_sub(count));
-    let out = splitter.node(refs, budget, 0);
-    if out.len() == count {
+    let parts = splitter.node(root, budget, 0);
+    if parts.iter().map(Vec::len).sum::<usize>() == count {
         return None;
     }
     Some(Fragments {
-        boxes: out.iter().map(PrimRef::bounds).collect(),
-        owner: out.iter().map(PrimRef::index).collect(),
+        boxes: parts.iter().flatten().map(PrimRef::bounds).collect(),
+        owner: parts.iter().flatten().map(PrimRef::index).collect(),
     })
 }
 
@@ -215,43 +256,46 @@ impl Bins {
     }
 }
 
-/// A node's grid of bins: `origin + k * width` starts bin `k` on each axis.
+/// A node's grid of bins: `planes[k]` starts bin `k` on each axis.
 #[derive(Clone, Copy)]
 struct Grid {
     origin: Vec3A,
-    width: Vec3A,
     /// Bins per unit of length (zero on a flat axis).
     scale: Vec3A,
+    planes: [Vec3A; BINS + 1],
 }
+
+/// The lanes of each axis, to replace one coordinate of a corner by a plane's.
+const AXIS: [BVec3A; 3] =
+    [BVec3A::new(true, false, false), BVec3A::new(false, true, false), BVec3A::new(false, false, true)];
 
 impl Grid {
     fn over(b: &Bounds) -> Self {
         let width = (b.hi - b.lo) / BINS as f32;
         let scale = Vec3A::select(width.cmpgt(Vec3A::ZERO), width.recip(), Vec3A::ZERO);
-        Grid { origin: b.lo, width, scale }
+        let planes = std::array::from_fn(|k| b.lo + k as f32 * width);
+        Grid { origin: b.lo, scale, planes }
     }
 
     /// The bins of `p` on the three axes (anything below the grid, and NaN, in bin 0).
-    #[inline]
+    #[inline(always)]
     fn bins(&self, p: Vec3A) -> [usize; 3] {
-        let k = ((p - self.origin) * self.scale).max(Vec3A::ZERO).min(Vec3A::splat((BINS - 1) as f32));
-        [k.x as usize, k.y as usize, k.z as usize]
+        // Below `BINS` already: the mask only spares the bounds checks.
+        bin_vector(p, self.origin, self.scale, Vec3A::splat((BINS - 1) as f32)).map(|k| k as usize & (BINS - 1))
     }
 
-    #[inline]
-    fn bin(&self, axis: usize, x: f32) -> usize {
-        let k = (x - self.origin[axis]) * self.scale[axis];
-        if k >= 0.0 { (k as usize).min(BINS - 1) } else { 0 }
-    }
-
-    #[inline]
-    fn plane(&self, axis: usize, k: usize) -> f32 {
-        self.origin[axis] + k as f32 * self.width[axis]
+    /// Whether `x` on `axis` falls in a bin before `bin` (in `1..BINS`), as [`Grid::bins`] bins
+    /// it: the bin is the integer part of the product, saturated, so it is below the integer
+    /// `bin` exactly when the product is (or is NaN, which goes to bin 0).
+    #[inline(always)]
+    fn before(&self, axis: usize, x: f32, bin: usize) -> bool {
+        !((x - self.origin[axis]) * self.scale[axis] >= bin as f32)
     }
 }
 
 /// The best split found on one axis: its SAH cost (areas times references), the bin it starts the
-/// right side at, and the two sides' boxes.
+/// right side at, the two sides' boxes and how many references they hold (for a spatial split, at
+/// most that many: a reference across the plane may go whole to one side).
 #[derive(Clone, Copy)]
 struct Best {
     cost: f32,
@@ -259,6 +303,7 @@ struct Best {
     bin: usize,
     left: Bounds,
     right: Bounds,
+    counts: (usize, usize),
 }
 
 /// The best split of a sweep over bins (their boxes, and the references counted on the left and on
@@ -287,27 +332,29 @@ fn sweep(
         }
         let cost = left.0.area() * left.1 as f32 + rb.area() * rn as f32;
         if best.is_none_or(|b| cost < b.cost) {
-            *best = Some(Best { cost, axis, bin: k, left: left.0, right: rb });
+            let counts = (left.1 as usize, rn as usize);
+            *best = Some(Best { cost, axis, bin: k, left: left.0, right: rb, counts });
         }
     }
 }
 
 impl<T: Fn(u32) -> [Vec3; 3] + Sync> Splits<'_, T> {
-    /// The references of the subtree over `refs`, at depth `depth`, cut where its splits say,
-    /// adding at most `budget` references.
-    fn node(&self, refs: Vec<Frag>, budget: usize, depth: u32) -> Vec<Frag> {
-        if depth >= self.levels || refs.len() < MIN_REFS || !refs.iter().any(is_large) {
-            return refs;
+    /// The references of the subtree over `node`, at depth `depth`, cut where its splits say,
+    /// adding at most `budget` references: in runs, to be read one after the other.
+    fn node(&self, node: Side, budget: usize, depth: u32) -> Vec<Vec<Frag>> {
+        if depth >= self.levels || node.refs.len() < MIN_REFS || node.large == 0 {
+            return vec![node.refs];
         }
-        let n = refs.len();
-        let Some((left, right)) = self.split(refs.as_slice(), budget) else {
-            return refs;
+        let n = node.refs.len();
+        let Some((left, right)) = self.split(&node, budget) else {
+            return vec![node.refs];
         };
-        drop(refs);
+        drop(node);
+        let (nl, nr) = (left.refs.len(), right.refs.len());
         // What is left of the budget, shared in proportion to each side's references.
-        let rest = budget.saturating_sub(left.len() + right.len() - n);
-        let to_left = (rest as f64 * left.len() as f64 / (left.len() + right.len()) as f64) as usize;
-        let (mut l, r) = if left.len().min(right.len()) >= PARALLEL_REFS / 4 {
+        let rest = budget.saturating_sub(nl + nr - n);
+        let to_left = (rest as f64 * nl as f64 / (nl + nr) as f64) as usize;
+        let (mut l, r) = if nl.min(nr) >= PARALLEL_REFS / 4 {
             parallel::join(|| self.node(left, to_left, depth + 1), || self.node(right, rest - to_left, depth + 1))
         } else {
             (self.node(left, to_left, depth + 1), self.node(right, rest - to_left, depth + 1))
@@ -317,13 +364,8 @@ impl<T: Fn(u32) -> [Vec3; 3] + Sync> Splits<'_, T> {
     }
 
     /// The node's two sides, by the best object or spatial split, or `None` if it has none.
-    fn split(&self, refs: &[Frag], budget: usize) -> Option<(Vec<Frag>, Vec<Frag>)> {
-        let (mut bounds, mut centroids) = (Bounds::EMPTY, Bounds::EMPTY);
-        for r in refs {
-            bounds.add(r.min(), r.max());
-            let c = r.centroid();
-            centroids.add(c, c);
-        }
+    fn split(&self, node: &Side, budget: usize) -> Option<(Side, Side)> {
+        let (refs, bounds, centroids) = (node.refs.as_slice(), node.bounds, node.centroids);
         let (cgrid, sgrid) = (Grid::over(&centroids), Grid::over(&bounds));
         let bins = if refs.len() >= PARALLEL_REFS {
             let parts = parallel::map_chunks(refs, PARALLEL_REFS / 2, |c| bin(c, &cgrid, &sgrid));
@@ -345,24 +387,25 @@ impl<T: Fn(u32) -> [Vec3; 3] + Sync> Splits<'_, T> {
         }
         match (object, spatial) {
             (o, Some(s)) if o.is_none_or(|o| s.cost < o.cost) => {
-                Some(self.cut(refs, s.axis, sgrid.plane(s.axis, s.bin)))
+                Some(self.cut(refs, s.axis, sgrid.planes[s.bin][s.axis], s.counts))
             }
             (Some(o), _) => {
-                let (l, r): (Vec<Frag>, Vec<Frag>) =
-                    refs.iter().partition(|f| cgrid.bin(o.axis, f.centroid_on(o.axis)) < o.bin);
-                (!l.is_empty() && !r.is_empty()).then_some((l, r))
+                let (mut l, mut r) = (Side::with_capacity(o.counts.0), Side::with_capacity(o.counts.1));
+                for f in refs {
+                    if cgrid.before(o.axis, f.centroid_on(o.axis), o.bin) { l.push(*f) } else { r.push(*f) }
+                }
+                (!l.refs.is_empty() && !r.refs.is_empty()).then_some((l, r))
             }
             (None, _) => None,
         }
     }
 
-    /// The two sides of a spatial split at `plane` on `axis`: the references on one side go there,
-    /// a large triangle's reference across the plane is cut in two, or goes whole to the side
-    /// where that costs less (Stich et al.'s unsplitting), any other across it goes by its
-    /// centroid, as binned.
-    fn cut(&self, refs: &[Frag], axis: usize, plane: f32) -> (Vec<Frag>, Vec<Frag>) {
-        let (mut l, mut r, mut across) = (Vec::new(), Vec::new(), Vec::new());
-        let (mut lb, mut rb) = (Aabb::EMPTY, Aabb::EMPTY);
+    /// The two sides of a spatial split at `plane` on `axis` (with about `counts` references): the
+    /// references on one side go there, a large triangle's reference across the plane is cut in
+    /// two, or goes whole to the side where that costs less (Stich et al.'s unsplitting), any
+    /// other across it goes by its centroid, as binned.
+    fn cut(&self, refs: &[Frag], axis: usize, plane: f32, counts: (usize, usize)) -> (Side, Side) {
+        let (mut l, mut r, mut across) = (Side::with_capacity(counts.0), Side::with_capacity(counts.1), Vec::new());
         for f in refs {
             let large = is_large(f);
             let (lo, hi) = (f.min()[axis], f.max()[axis]);
@@ -374,13 +417,7 @@ impl<T: Fn(u32) -> [Vec3; 3] + Sync> Splits<'_, T> {
             } else {
                 f.centroid_on(axis) < plane
             };
-            if to_left {
-                lb = lb.union(&f.bounds());
-                l.push(*f);
-            } else {
-                rb = rb.union(&f.bounds());
-                r.push(*f);
-            }
+            if to_left { l.push(*f) } else { r.push(*f) }
         }
         for f in across {
             let whole = f.bounds();
@@ -389,20 +426,17 @@ impl<T: Fn(u32) -> [Vec3; 3] + Sync> Splits<'_, T> {
             below.max[axis] = plane;
             above.min[axis] = plane;
             let (cl, cr) = (clip_triangle(v, &below), clip_triangle(v, &above));
-            let (nl, nr) = (l.len() as f32, r.len() as f32);
+            let (nl, nr) = (l.refs.len() as f32, r.refs.len() as f32);
+            let (lb, rb) = (l.bounds.aabb(), r.bounds.aabb());
             let area = |b: Aabb| b.surface_area();
             let both = area(lb.union(&cl)) * (nl + 1.0) + area(rb.union(&cr)) * (nr + 1.0);
             let left = area(lb.union(&whole)) * (nl + 1.0) + area(rb) * nr;
             let right = area(lb) * nl + area(rb.union(&whole)) * (nr + 1.0);
             if cl.is_empty() || (right <= both && right <= left) {
-                rb = rb.union(&whole);
                 r.push(f);
             } else if cr.is_empty() || left <= both {
-                lb = lb.union(&whole);
                 l.push(f);
             } else {
-                lb = lb.union(&cl);
-                rb = rb.union(&cr);
                 l.push(frag(&cl, f.index(), true));
                 r.push(frag(&cr, f.index(), true));
             }
@@ -420,27 +454,36 @@ fn bin(refs: &[Frag], cgrid: &Grid, sgrid: &Grid) -> Bins {
     for r in refs {
         let (lo, hi, c) = (r.min(), r.max(), r.centroid());
         let cb = cgrid.bins(c);
-        let (first, last) = if is_large(r) { (sgrid.bins(lo), sgrid.bins(hi)) } else { (sgrid.bins(c), sgrid.bins(c)) };
         for axis in 0..3 {
             bins.object[axis][cb[axis]].add(lo, hi);
             bins.counts[axis][cb[axis]] += 1;
+        }
+        if !is_large(r) {
+            let sb = sgrid.bins(c);
+            for axis in 0..3 {
+                bins.spatial[axis][sb[axis]].add(lo, hi);
+                bins.enter[axis][sb[axis]] += 1;
+                bins.exit[axis][sb[axis]] += 1;
+            }
+            continue;
+        }
+        let (first, last) = (sgrid.bins(lo), sgrid.bins(hi));
+        for axis in 0..3 {
             let (a, b) = (first[axis], last[axis]);
             bins.enter[axis][a] += 1;
             bins.exit[axis][b] += 1;
-            if a == b {
+            if a >= b {
                 bins.spatial[axis][a].add(lo, hi);
                 continue;
             }
-            for k in a..=b {
-                let (mut plo, mut phi) = (lo, hi);
-                if k != a {
-                    plo[axis] = sgrid.plane(axis, k);
-                }
-                if k != b {
-                    phi[axis] = sgrid.plane(axis, k + 1);
-                }
-                bins.spatial[axis][k].add(plo, phi);
+            // The part in each bin: the box, its coordinate on `axis` cut to the bin's planes.
+            let on = AXIS[axis];
+            bins.spatial[axis][a].add(lo, Vec3A::select(on, sgrid.planes[a + 1], hi));
+            for k in a + 1..b {
+                bins.spatial[axis][k]
+                    .add(Vec3A::select(on, sgrid.planes[k], lo), Vec3A::select(on, sgrid.planes[k + 1], hi));
             }
+            bins.spatial[axis][b].add(Vec3A::select(on, sgrid.planes[b], lo), hi);
         }
     }
     bins

@@ -247,7 +247,7 @@ fn past_plane(c: Vec4, min: Vec4, scale: Vec4, plane: Vec4) -> u32 {
 /// conversion sends it: x86's `max` returns its second operand, zero, for a NaN, and elsewhere
 /// the saturating conversion below maps a NaN that went through to zero).
 #[inline(always)]
-fn bin_vector(c: Vec3A, min: Vec3A, scale: Vec3A, last: Vec3A) -> [u32; 3] {
+pub(crate) fn bin_vector(c: Vec3A, min: Vec3A, scale: Vec3A, last: Vec3A) -> [u32; 3] {
     let clamped = ((c - min) * scale).max(Vec3A::ZERO).min(last);
     // In range already: a plain truncation, without the saturating conversion's branches.
     #[cfg(target_arch = "x86_64")]
