@@ -22,11 +22,15 @@
 # target/ab-bench/runs/; the binaries in target/ab-bench/bin/, by commit and placement, for the
 # next comparison.
 #
+# Each scene's build is compared too, as builds per second (the harness's median of BUILD_REPS
+# builds on THREADS threads): to time builds, give BUILD_REPS of 5 or more and THREADS 2, with a
+# cheap cell and few RAYS.
+#
 # Environment (defaults in brackets): ALIGNS ["32 64"], CELLS
 # [primary-closest,random-closest,random-any,bounce-closest], LIBRARY [englobe; englobe-packet16
-# times the packet walks], RAYS [500000], RESOLUTION [512],
-# REPS [5], ENGLOBE_SHARED [../shared], SCENES [the bunny, the ogre and the Sponza seen from
-# inside, as harness arguments].
+# times the packet walks], RAYS [500000], RESOLUTION [512], REPS [5], THREADS [1], BUILD_REPS [1],
+# ENGLOBE_SHARED [../shared], SCENES [the bunny, the ogre and the Sponza seen from inside, as
+# harness arguments].
 set -euo pipefail
 cd "$(dirname "$0")/.."
 [[ $# -ge 2 ]] || { sed -n '8,8s/^# \{0,1\}//p' "$0" >&2; exit 2; }
@@ -80,7 +84,8 @@ for round in $(seq 1 "$rounds"); do
     ((round % 2 == 0)) && order=(B A)
     for align in "${aligns[@]}"; do
         for side in "${order[@]}"; do
-            "$work/run-$side-$align" --threads 1 --reps "${REPS:-5}" --build-reps 1 --no-check --quiet \
+            "$work/run-$side-$align" --threads "${THREADS:-1}" --reps "${REPS:-5}" --build-reps "${BUILD_REPS:-1}" \
+                --no-check --quiet \
                 --libraries "${LIBRARY:-englobe}" --cells "$cells" --rays "${RAYS:-500000}" --resolution "${RESOLUTION:-512}" \
                 --csv "$work/runs/$side-$align-$round.csv" "${scenes[@]}" > /dev/null
         done
@@ -88,7 +93,7 @@ for round in $(seq 1 "$rounds"); do
     echo "round $round of $rounds done" >&2
 done
 
-echo "A: $1 ($(git rev-parse --short "$1")), B: $2 ($(git rev-parse --short "$2")); ${LIBRARY:-englobe}, $rounds rounds, one thread"
+echo "A: $1 ($(git rev-parse --short "$1")), B: $2 ($(git rev-parse --short "$2")); ${LIBRARY:-englobe}, $rounds rounds, ${THREADS:-1} thread(s)"
 python3 - "$work/runs" "${aligns[@]}" <<'EOF'
 import csv, pathlib, statistics, sys
 from collections import defaultdict
@@ -101,6 +106,9 @@ for path in sorted(runs.glob("*.csv")):
         if row["rays"] != "build":
             cell = f'{row["scene"]} {row["rays"]} {row["query"]}'
             by_round[cell, side, align, round_] = float(row["mrays_per_s"])
+            # Every row of a scene repeats its build's time; as a rate, so that B/A above 1 is
+            # B faster, as for rays.
+            by_round[f'{row["scene"]} build (per s)', side, align, round_] = 1000.0 / float(row["build_ms"])
 rates = defaultdict(list)  # (cell, side, align) -> rays per second of each round
 for (cell, side, align, _), rate in by_round.items():
     rates[cell, side, align].append(rate)
