@@ -468,16 +468,16 @@ fn bin(refs: &[Frag], cgrid: &Grid, sgrid: &Grid) -> Bins {
     for r in refs {
         let (lo, hi, c) = (r.min(), r.max(), r.centroid());
         let cb = cgrid.bins(c);
-        for axis in 0..3 {
-            bins.object[axis][cb[axis]].add(lo, hi);
-            bins.counts[axis][cb[axis]] += 1;
+        for (axis, &k) in cb.iter().enumerate() {
+            bins.object[axis][k].add(lo, hi);
+            bins.counts[axis][k] += 1;
         }
         if !is_large(r) {
             let sb = sgrid.bins(c);
-            for axis in 0..3 {
-                bins.spatial[axis][sb[axis]].add(lo, hi);
-                bins.enter[axis][sb[axis]] += 1;
-                bins.exit[axis][sb[axis]] += 1;
+            for (axis, &k) in sb.iter().enumerate() {
+                bins.spatial[axis][k].add(lo, hi);
+                bins.enter[axis][k] += 1;
+                bins.exit[axis][k] += 1;
             }
             continue;
         }
