@@ -453,7 +453,7 @@ fn sides(v: [Vec3; 3], part: Aabb, axis: usize, plane: f32) -> (Aabb, Aabb) {
         return (clip_triangle(v, &below), clip_triangle(v, &above));
     }
     // The whole triangle: its box's planes cut nothing, and one pass over its edges gives both
-    // sides, the same polygons as clipping (half the time of clipping twice).
+    // sides, the same polygons that clipping against the two half-boxes gives in twelve passes.
     let (mut b, mut a) = (Polygon::empty(), Polygon::empty());
     Polygon::triangle(v).split_into(axis, plane as f64, &mut b, &mut a);
     (b.bounds().intersection(&below), a.bounds().intersection(&above))
