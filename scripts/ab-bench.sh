@@ -108,7 +108,8 @@ for path in sorted(runs.glob("*.csv")):
             by_round[cell, side, align, round_] = float(row["mrays_per_s"])
             # Every row of a scene repeats its build's time; as a rate, so that B/A above 1 is
             # B faster, as for rays.
-            by_round[f'{row["scene"]} build (per s)', side, align, round_] = 1000.0 / float(row["build_ms"])
+            if row["build_ms"]:
+                by_round[f'{row["scene"]} build (per s)', side, align, round_] = 1000.0 / float(row["build_ms"])
 rates = defaultdict(list)  # (cell, side, align) -> rays per second of each round
 for (cell, side, align, _), rate in by_round.items():
     rates[cell, side, align].append(rate)
