@@ -263,8 +263,9 @@ impl TriangleBvh {
         let budget = options.presplit_percent as f32 / 100.0;
         // The fragments, if any triangle is cut; else the build takes the references as they are.
         // Spatial splits where the scene has large triangles, else the pre-split.
-        let fragments = spatial_cuts(stored, describe, |k| triangle(refs[k as usize].index()), options.spatial_levels)
-            .or_else(|| presplit_cuts(stored, describe, |k| triangle(refs[k as usize].index()), budget));
+        let kept = |k: u32| triangle(refs[k as usize].index());
+        let fragments = spatial_cuts(stored, describe, kept, options.spatial_levels)
+            .or_else(|| presplit_cuts(stored, describe, kept, budget));
         let cut = fragments.as_ref().is_some_and(|f| f.boxes.len() > stored);
         let options_wide = ConvertOptions { collapse: options.collapse };
         // The fragments' boxes and the triangle each names, if some were left out (else a
